@@ -1,0 +1,59 @@
+//! Even extension of boundary data on an open interval to a periodic function (SPEC §2).
+
+use super::{Field, FieldRef, VecJet};
+use crate::jet::{Jet, JetShape};
+use std::f64::consts::PI;
+
+/// The even, 2π-periodic extension `g̃(θ)` of a function `g(v)` on `[v₀, v₁]`:
+/// `g̃(θ) = g(v₀ + (v₁ − v₀) θ/π)` for `θ ∈ [0, π]` and `g̃(θ) = g̃(2π − θ)` on `[π, 2π]`.
+///
+/// `g̃` is continuous and periodic; its Fourier series has cosine terms only and converges
+/// like `1/n²`. Derivatives are exact inside each half (`dᵏ/dθᵏ = (±(v₁ − v₀)/π)ᵏ dᵏ/dvᵏ`);
+/// at `θ = 0, π` the odd derivatives jump unless `g` has zero slope there.
+#[derive(Clone, Debug)]
+pub struct EvenExtension {
+    inner: FieldRef,
+    v0: f64,
+    v1: f64,
+}
+
+impl EvenExtension {
+    /// Extends `inner` (slot 0 = v on `[v0, v1]`; other slots pass through).
+    pub fn new(inner: FieldRef, v0: f64, v1: f64) -> Self {
+        EvenExtension { inner, v0, v1 }
+    }
+
+    /// Maps θ to `(v, dv/dθ)`.
+    pub fn map(&self, theta: f64) -> (f64, f64) {
+        let th = theta.rem_euclid(2.0 * PI);
+        let k = (self.v1 - self.v0) / PI;
+        if th <= PI {
+            (self.v0 + k * th, k)
+        } else {
+            (self.v0 + k * (2.0 * PI - th), -k)
+        }
+    }
+}
+
+impl Field for EvenExtension {
+    fn arity(&self) -> usize {
+        self.inner.arity().max(1)
+    }
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let (v, dv) = self.map(at[0]);
+        let mut a = at.to_vec();
+        a[0] = v;
+        let j = self.inner.jet(&a, shape);
+        VecJet(std::array::from_fn(|k| {
+            let c: Vec<f64> = shape
+                .multi_indices()
+                .zip(j.0[k].coeffs())
+                .map(|(m, c)| c * dv.powi(m[0] as i32))
+                .collect();
+            Jet::from_coeffs(shape, c)
+        }))
+    }
+    fn is_constant_in(&self, slot: usize) -> bool {
+        self.inner.is_constant_in(slot)
+    }
+}

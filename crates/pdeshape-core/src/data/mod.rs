@@ -1,0 +1,175 @@
+//! Boundary data (SPEC §2): vector-valued functions of one to three parameters.
+//!
+//! Everything a condition can prescribe — a curve `g(v)`, a moving curve `g(v, t)`, a
+//! boundary surface `S(u, v)` of a solid, a primary surface `S(s, v, t)` — is a [`Field`]:
+//! a map from parameters to R³ whose partial derivatives of every order are available
+//! exactly as [`VecJet`]s. Conventions for the parameter slots:
+//!
+//! | use                          | slots        |
+//! |------------------------------|--------------|
+//! | boundary curve               | `(v, t)`     |
+//! | primary surface              | `(s, v, t)`  |
+//! | solid boundary surface       | `(u, v)`     |
+//!
+//! A field ignores slots it does not depend on (a B-spline curve is constant in `t`).
+
+mod bspline;
+mod combine;
+mod expr_field;
+mod extension;
+pub mod fourier;
+mod trimline;
+
+pub use bspline::{BSplineCurve, BSplineError};
+pub use combine::Combination;
+pub use expr_field::ExprField;
+pub use extension::EvenExtension;
+pub use trimline::Trimline;
+
+use crate::Vec3;
+use crate::jet::{Jet, JetShape, MAX_VARS};
+use std::fmt::Debug;
+use std::sync::Arc;
+
+/// The jets of the three components of a vector function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VecJet(pub [Jet; 3]);
+
+impl VecJet {
+    /// The constant jet with value `p`.
+    pub fn constant(shape: JetShape, p: Vec3) -> Self {
+        VecJet([
+            Jet::constant(shape, p.x),
+            Jet::constant(shape, p.y),
+            Jet::constant(shape, p.z),
+        ])
+    }
+
+    /// A jet from Taylor coefficients given as vectors in storage order.
+    pub fn from_vec_coeffs(shape: JetShape, c: &[Vec3]) -> Self {
+        VecJet(std::array::from_fn(|k| {
+            Jet::from_coeffs(shape, c.iter().map(|p| p[k]).collect())
+        }))
+    }
+
+    /// The shape.
+    pub fn shape(&self) -> JetShape {
+        self.0[0].shape()
+    }
+
+    /// The value.
+    pub fn value(&self) -> Vec3 {
+        Vec3::new(self.0[0].value(), self.0[1].value(), self.0[2].value())
+    }
+
+    /// The partial derivative of multi-index `m` (exact).
+    pub fn derivative(&self, m: [usize; MAX_VARS]) -> Vec3 {
+        Vec3::new(
+            self.0[0].derivative(m),
+            self.0[1].derivative(m),
+            self.0[2].derivative(m),
+        )
+    }
+
+    /// True when every coefficient is finite.
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().all(|j| j.is_finite())
+    }
+}
+
+/// A vector-valued function of up to three parameters with exact partial derivatives.
+pub trait Field: Send + Sync + Debug {
+    /// Number of parameter slots the field reads (see the module docs).
+    fn arity(&self) -> usize;
+
+    /// The jet of the field at `at`, truncated to `shape`. `at` holds at least `arity()`
+    /// slots; extra slots are ignored.
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet;
+
+    /// The value at `at`.
+    fn eval(&self, at: &[f64]) -> Vec3 {
+        self.jet(at, JetShape::scalar()).value()
+    }
+
+    /// True when the field does not depend on slot `slot` (e.g. time for a B-spline).
+    fn is_constant_in(&self, _slot: usize) -> bool {
+        false
+    }
+}
+
+/// A shared, type-erased field.
+pub type FieldRef = Arc<dyn Field>;
+
+/// A constant point (a degenerate curve: a pole of the patch).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointField {
+    /// The point.
+    pub point: Vec3,
+    /// Number of parameter slots reported by [`Field::arity`].
+    pub arity: usize,
+}
+
+impl Field for PointField {
+    fn arity(&self) -> usize {
+        self.arity
+    }
+    fn jet(&self, _at: &[f64], shape: JetShape) -> VecJet {
+        VecJet::constant(shape, self.point)
+    }
+    fn is_constant_in(&self, _slot: usize) -> bool {
+        true
+    }
+}
+
+/// A closure field, convenient in tests and for programmatic data: `f(at, shape)`.
+pub struct FnField<F> {
+    f: F,
+    arity: usize,
+}
+
+impl<F> FnField<F>
+where
+    F: Fn(&[Jet]) -> [Jet; 3] + Send + Sync,
+{
+    /// A field from a function of jets (its derivatives are then exact by construction).
+    ///
+    /// ```
+    /// use pdeshape_core::data::{Field, FnField};
+    /// use pdeshape_core::jet::JetShape;
+    /// let circle = FnField::new(2, |p| [p[0].cos(), p[0].sin(), p[1].clone()]);
+    /// let j = circle.jet(&[0.0, 0.5], JetShape::new(&[2, 0]));
+    /// assert_eq!(j.derivative([2, 0, 0]).x, -1.0);
+    /// ```
+    pub fn new(arity: usize, f: F) -> Self {
+        FnField { f, arity }
+    }
+}
+
+impl<F> Debug for FnField<F> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "FnField(arity {})", self.arity)
+    }
+}
+
+impl<F> Field for FnField<F>
+where
+    F: Fn(&[Jet]) -> [Jet; 3] + Send + Sync,
+{
+    fn arity(&self) -> usize {
+        self.arity
+    }
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let vars: Vec<Jet> = at
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| Jet::variable(shape, i, x))
+            .collect();
+        VecJet((self.f)(&vars))
+    }
+}
+
+/// Convenience: the `k`-th derivative in slot 0 of a curve at `(v, t)`.
+pub fn curve_derivative(f: &dyn Field, v: f64, t: f64, k: usize) -> Vec3 {
+    let at = [v, t];
+    f.jet(&at, JetShape::new(&[k])).derivative([k, 0, 0])
+}

@@ -1,0 +1,157 @@
+//! Algebraic expansion of an expression into a sum of (constant × product term).
+//!
+//! Used to extract the basis functions `F_j(v, t)` of dynamic blends (SPEC §5): an
+//! expression is multiplied out over `+`, `−`, `·`, division by constants and small
+//! non-negative integer powers; everything else (function calls, division by a
+//! non-constant, other powers) is an opaque factor. Terms whose sorted factor lists print
+//! the same are collected, so `(1 − t)·sin v + 2t·sin v` expands to `1·sin v + 1·t·sin v`.
+
+use super::{BinOp, Expr, Node, Span};
+
+/// One term `coef · Π factors` of an expanded expression.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Term {
+    /// The numeric coefficient.
+    pub coef: f64,
+    /// The non-constant factors (empty for the constant term), sorted by their printed form.
+    pub factors: Vec<Expr>,
+}
+
+impl Term {
+    /// A canonical key: the printed factors joined by `*` (`"1"` for the constant term).
+    pub fn key(&self) -> String {
+        if self.factors.is_empty() {
+            "1".into()
+        } else {
+            self.factors
+                .iter()
+                .map(|f| f.to_string())
+                .collect::<Vec<_>>()
+                .join("*")
+        }
+    }
+
+    /// The product of the factors (without the coefficient) as an expression.
+    pub fn product(&self) -> Expr {
+        let mut it = self.factors.iter().cloned();
+        let first = it.next().unwrap_or_else(|| Expr::num(1.0));
+        it.fold(first, |acc, f| Expr {
+            span: Span { start: 0, end: 0 },
+            node: Node::Bin(BinOp::Mul, Box::new(acc), Box::new(f)),
+        })
+    }
+}
+
+fn raw(e: &Expr) -> Vec<Term> {
+    match &e.node {
+        Node::Num(c) => vec![Term {
+            coef: *c,
+            factors: vec![],
+        }],
+        Node::Neg(a) => raw(a)
+            .into_iter()
+            .map(|t| Term { coef: -t.coef, ..t })
+            .collect(),
+        Node::Bin(BinOp::Add, a, b) => {
+            let mut r = raw(a);
+            r.extend(raw(b));
+            r
+        }
+        Node::Bin(BinOp::Sub, a, b) => {
+            let mut r = raw(a);
+            r.extend(raw(b).into_iter().map(|t| Term { coef: -t.coef, ..t }));
+            r
+        }
+        Node::Bin(BinOp::Mul, a, b) => product(&raw(a), &raw(b)),
+        Node::Bin(BinOp::Div, a, b) if b.as_constant().is_some() => {
+            let c = b.as_constant().unwrap_or(1.0);
+            raw(a)
+                .into_iter()
+                .map(|t| Term {
+                    coef: t.coef / c,
+                    ..t
+                })
+                .collect()
+        }
+        Node::Bin(BinOp::Pow, a, b) if matches!(b.as_constant(), Some(n) if n >= 0.0 && n == n.round() && n <= 8.0) =>
+        {
+            let n = b.as_constant().unwrap_or(0.0) as usize;
+            let base = raw(a);
+            (0..n).fold(
+                vec![Term {
+                    coef: 1.0,
+                    factors: vec![],
+                }],
+                |acc, _| product(&acc, &base),
+            )
+        }
+        _ => vec![Term {
+            coef: 1.0,
+            factors: vec![e.clone()],
+        }],
+    }
+}
+
+fn product(a: &[Term], b: &[Term]) -> Vec<Term> {
+    let mut out = Vec::with_capacity(a.len() * b.len());
+    for x in a {
+        for y in b {
+            let mut f = x.factors.clone();
+            f.extend(y.factors.iter().cloned());
+            out.push(Term {
+                coef: x.coef * y.coef,
+                factors: f,
+            });
+        }
+    }
+    out
+}
+
+/// Expands a (bound) expression into collected terms, in order of first appearance.
+/// Terms whose coefficients cancel exactly are dropped.
+///
+/// ```
+/// use pdeshape_core::expr::{Expr, expand};
+/// let e = Expr::parse("(1 - t)*(2*sin(v) + 3) + t*sin(v)").unwrap().bind(&["v", "t"], &|_| None).unwrap();
+/// let terms = expand(&e);
+/// let keys: Vec<String> = terms.iter().map(|t| format!("{}:{}", t.coef, t.key())).collect();
+/// assert_eq!(keys, ["2:sin(#0)", "3:1", "-1:#1*sin(#0)", "-3:#1"]);
+/// ```
+pub fn expand(e: &Expr) -> Vec<Term> {
+    let mut out: Vec<(String, Term)> = Vec::new();
+    for mut t in raw(e) {
+        t.factors.sort_by_key(|f| f.to_string());
+        let k = t.key();
+        if let Some((_, acc)) = out.iter_mut().find(|(key, _)| *key == k) {
+            acc.coef += t.coef;
+        } else {
+            out.push((k, t));
+        }
+    }
+    out.into_iter()
+        .map(|(_, t)| t)
+        .filter(|t| t.coef != 0.0)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expansion_reproduces_the_expression() {
+        let src = "(1 - t)*(1.5*sinh(0.5*v + 0.1) + 2*sin(3*v))^2 / 4 - t*(v - 1)*cos(-v)";
+        let e = Expr::parse(src)
+            .unwrap()
+            .bind(&["v", "t"], &|_| None)
+            .unwrap();
+        let terms = expand(&e);
+        for &(v, t) in &[(0.3, 0.2), (-1.0, 0.7), (2.5, 0.0)] {
+            let s: f64 = terms
+                .iter()
+                .map(|tm| tm.coef * tm.product().eval(&[v, t]))
+                .sum();
+            assert!((s - e.eval(&[v, t])).abs() < 1e-12);
+        }
+    }
+}

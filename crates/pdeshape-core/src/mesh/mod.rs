@@ -1,0 +1,124 @@
+//! Meshes (SPEC §8): structured grid meshes with analytic normals, UVs and scalar fields;
+//! hexahedral volume meshes; morph-target animations.
+
+mod grid;
+
+pub use grid::{GridOptions, grid_mesh, grid_params};
+
+use crate::Vec3;
+
+/// A named per-vertex (or per-cell) scalar field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarField {
+    /// Field name (e.g. `residual`, `mean_curvature`, `c1_gap`).
+    pub name: String,
+    /// One value per vertex (or cell).
+    pub values: Vec<f64>,
+}
+
+/// A sequence of vertex positions (and normals) over time: a morph-target animation of a
+/// mesh whose connectivity does not change.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct MorphAnimation {
+    /// Frame times.
+    pub times: Vec<f64>,
+    /// Positions per frame (each as long as the mesh's vertex list).
+    pub positions: Vec<Vec<Vec3>>,
+    /// Normals per frame.
+    pub normals: Vec<Vec<Vec3>>,
+}
+
+/// A surface mesh: quads and/or triangles over shared vertices.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Mesh {
+    /// Name (the patch name; a group/node name in exports).
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals (empty or one per vertex).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (empty or one per vertex), the patch parameters scaled to [0, 1].
+    pub uvs: Vec<[f64; 2]>,
+    /// Quadrilaterals (counter-clockwise about the normal).
+    pub quads: Vec<[u32; 4]>,
+    /// Triangles (counter-clockwise about the normal).
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-vertex scalar fields.
+    pub fields: Vec<ScalarField>,
+    /// `(nu, nv)` vertex counts when the mesh is a structured grid (row-major in `u`).
+    pub grid: Option<(usize, usize)>,
+    /// Polylines to highlight (boundary curves), drawn by the renderer.
+    pub curves: Vec<Vec<Vec3>>,
+    /// Optional animation of the vertices.
+    pub animation: Option<MorphAnimation>,
+}
+
+impl Mesh {
+    /// All faces as triangles (quads split along their shorter diagonal).
+    pub fn all_triangles(&self) -> Vec<[u32; 3]> {
+        let mut t = self.triangles.clone();
+        for q in &self.quads {
+            let p = |i: usize| self.positions[q[i] as usize];
+            if (p(0) - p(2)).norm() <= (p(1) - p(3)).norm() {
+                t.push([q[0], q[1], q[2]]);
+                t.push([q[0], q[2], q[3]]);
+            } else {
+                t.push([q[0], q[1], q[3]]);
+                t.push([q[1], q[2], q[3]]);
+            }
+        }
+        t
+    }
+
+    /// Axis-aligned bounds `(min, max)`; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.positions.iter();
+        let first = *it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+    }
+
+    /// The field with the given name.
+    pub fn field(&self, name: &str) -> Option<&ScalarField> {
+        self.fields.iter().find(|f| f.name == name)
+    }
+
+    /// Checks that every coordinate, normal and field value is finite.
+    pub fn check_finite(&self) -> Result<(), String> {
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "mesh `{}`: vertex {i} has a non-finite position",
+                self.name
+            ));
+        }
+        if let Some(i) = self.normals.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "mesh `{}`: vertex {i} has a non-finite normal",
+                self.name
+            ));
+        }
+        for f in &self.fields {
+            if let Some(i) = f.values.iter().position(|x| !x.is_finite()) {
+                return Err(format!(
+                    "mesh `{}`: field `{}` is not finite at vertex {i}",
+                    self.name, f.name
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A hexahedral volume mesh (VTK cell ordering: bottom face counter-clockwise, then top).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct HexMesh {
+    /// Name.
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Hexahedra, 8 vertex indices each.
+    pub hexes: Vec<[u32; 8]>,
+    /// Per-vertex fields.
+    pub point_fields: Vec<ScalarField>,
+    /// Per-cell fields.
+    pub cell_fields: Vec<ScalarField>,
+}

@@ -1,0 +1,132 @@
+//! Patches: maps `X(u, v)` from the parameter domain `[0, 1] × V` to R³ (SPEC §1).
+//!
+//! Every patch kind implements [`Surface`], which exposes exact partial derivatives, so
+//! meshing (normals), condition checks and continuity diagnostics work the same way for
+//! all of them. Conditions ([`Condition`]) prescribe `∂ᵈX/∂uᵈ (uᵢ, v) = gᵢ(v)`.
+
+mod hermite;
+mod primary;
+
+pub use hermite::{HermiteBasis, HermitePatch, HermitePatchError, Poly};
+pub use primary::PrimarySurface;
+
+use crate::Vec3;
+use crate::data::FieldRef;
+use std::f64::consts::PI;
+
+/// The transverse parameter domain `V`: an interval, periodic or not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VDomain {
+    /// Start of the interval.
+    pub start: f64,
+    /// End of the interval.
+    pub end: f64,
+    /// True when `X(u, start) = X(u, end)` with all derivatives (closed patches).
+    pub periodic: bool,
+}
+
+impl VDomain {
+    /// The closed-patch domain `[0, 2π)`.
+    pub const PERIODIC: VDomain = VDomain {
+        start: 0.0,
+        end: 2.0 * PI,
+        periodic: true,
+    };
+
+    /// An open domain `[start, end]`.
+    pub fn open(start: f64, end: f64) -> Self {
+        VDomain {
+            start,
+            end,
+            periodic: false,
+        }
+    }
+
+    /// The point `start + f (end − start)`.
+    pub fn at(&self, f: f64) -> f64 {
+        self.start + f * (self.end - self.start)
+    }
+}
+
+/// A condition `∂ᵈX/∂uᵈ (u, v) = g(v, t)` (SPEC §1): position (`d = 0`), tangent (`d = 1`),
+/// curvature-type (`d = 2`), …
+#[derive(Clone, Debug)]
+pub struct Condition {
+    /// Where, in the blend direction.
+    pub u: f64,
+    /// Derivative order `d`.
+    pub order: usize,
+    /// The prescribed data `g`, slots `(v, t)`.
+    pub data: FieldRef,
+}
+
+/// A patch `X: [0, 1] × V → R³` with exact partial derivatives.
+pub trait Surface: Send + Sync {
+    /// The transverse domain.
+    fn v_domain(&self) -> VDomain;
+
+    /// The partial derivatives `∂^{i+j}X/∂uⁱ∂vʲ (u, v)` for `i ≤ du`, `j ≤ dv`, stored at
+    /// index `i (dv + 1) + j`.
+    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3>;
+
+    /// `X(u, v)`.
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        self.derivatives(u, v, 0, 0)[0]
+    }
+
+    /// `∂ᵏX/∂uᵏ (u, v)`.
+    fn u_derivative(&self, u: f64, v: f64, k: usize) -> Vec3 {
+        self.derivatives(u, v, k, 0)[k]
+    }
+}
+
+/// Result of checking a patch against its conditions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConditionReport {
+    /// Largest `|∂ᵈX/∂uᵈ(uᵢ, v) − gᵢ(v)|` over all conditions and samples.
+    pub max_abs: f64,
+    /// `max_abs` divided by the patch size (bounding-box diagonal of the samples).
+    pub max_rel: f64,
+    /// The patch size used.
+    pub size: f64,
+}
+
+/// Checks every condition at `samples` equispaced `v` (plus pseudo-random jitter so no
+/// grid is favoured) at time `t`.
+pub fn check_conditions(
+    s: &dyn Surface,
+    conds: &[Condition],
+    t: f64,
+    samples: usize,
+) -> ConditionReport {
+    let dom = s.v_domain();
+    let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    let mut max_abs: f64 = 0.0;
+    for k in 0..samples {
+        // a low-discrepancy jitter (golden ratio) keeps the samples off any solver grid
+        let f = ((k as f64 + 0.5) / samples as f64 + 0.618_033_988_749_895 * 1e-3 * k as f64) % 1.0;
+        let v = dom.at(f);
+        for c in conds {
+            let x = s.u_derivative(c.u, v, c.order);
+            let g = c.data.eval(&[v, t]);
+            let e = (x - g).norm();
+            max_abs = if e.is_nan() { f64::NAN } else { max_abs.max(e) };
+            if c.order == 0 {
+                lo = lo.min(x);
+                hi = hi.max(x);
+            }
+        }
+        for &u in &[0.0, 0.5, 1.0] {
+            let p = s.point(u, v);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let size = (hi - lo).norm().max(f64::MIN_POSITIVE);
+    ConditionReport {
+        max_abs,
+        max_rel: max_abs / size,
+        size,
+    }
+}
