@@ -1,14 +1,9 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! # pdeshape-io
+//!
+//! Scene files, exporters and pictures for pdeshape: everything that touches a file
+//! format. The mathematics lives in `pdeshape-core`.
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+#![warn(missing_docs)]
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub mod export;
+pub mod scene;

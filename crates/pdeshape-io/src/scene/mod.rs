@@ -1,0 +1,192 @@
+//! Scene files (SPEC §9): a TOML description of parameters, curves, primary surfaces,
+//! patches, the picture and the outputs, resolved into core objects.
+//!
+//! The format is documented, with every key, in `examples/README.md`. Errors name the
+//! file, line, column and key, and say what was expected.
+
+mod build;
+mod error;
+mod raw;
+
+pub use build::{MAX_VERTICES, RESERVED};
+pub use error::{SceneError, Source};
+
+use indexmap::IndexMap;
+use pdeshape_core::data::FieldRef;
+use pdeshape_core::patch::{Condition, Surface, VDomain};
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// A numeric scene parameter (a slider in the editor).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param {
+    /// Current value.
+    pub value: f64,
+    /// The expression it was defined by, for derived parameters.
+    pub expr: Option<String>,
+    /// Slider minimum.
+    pub min: Option<f64>,
+    /// Slider maximum.
+    pub max: Option<f64>,
+    /// Slider step.
+    pub step: Option<f64>,
+    /// Free text.
+    pub description: Option<String>,
+}
+
+/// A primary surface of the scene.
+#[derive(Clone, Debug)]
+pub struct SceneSurface {
+    /// Name.
+    pub name: String,
+    /// `S(s, v, t)`.
+    pub field: FieldRef,
+    /// The part drawn in context, if any.
+    pub s_range: Option<(f64, f64)>,
+    /// Its v domain.
+    pub domain: VDomain,
+    /// Context mesh resolution.
+    pub resolution: (usize, usize),
+}
+
+/// What a patch is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatchKind {
+    /// Ruled/Hermite interpolation in `u` (no PDE).
+    Hermite,
+}
+
+impl PatchKind {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            PatchKind::Hermite => "hermite",
+        }
+    }
+}
+
+/// A patch of the scene, solved.
+#[derive(Clone)]
+pub struct ScenePatch {
+    /// Name.
+    pub name: String,
+    /// Kind.
+    pub kind: PatchKind,
+    /// The solved patch.
+    pub surface: Arc<dyn Surface>,
+    /// Its conditions.
+    pub conditions: Vec<Condition>,
+    /// Mesh resolution `(nu, nv)` in vertices.
+    pub resolution: (usize, usize),
+    /// Display colour.
+    pub color: Option<[f64; 3]>,
+}
+
+impl std::fmt::Debug for ScenePatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ScenePatch")
+            .field("name", &self.name)
+            .field("kind", &self.kind)
+            .field("resolution", &self.resolution)
+            .finish()
+    }
+}
+
+/// Picture settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Camera azimuth (degrees).
+    pub azimuth: f64,
+    /// Camera elevation (degrees).
+    pub elevation: f64,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Draw mesh lines.
+    pub wireframe: bool,
+    /// Colour by this field.
+    pub field: Option<String>,
+    /// Zoom factor.
+    pub zoom: f64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            azimuth: 35.0,
+            elevation: 25.0,
+            size: (800, 600),
+            wireframe: false,
+            field: None,
+            zoom: 1.0,
+        }
+    }
+}
+
+/// A loaded and resolved scene.
+#[derive(Debug)]
+pub struct Scene {
+    /// The file label (path or name).
+    pub file: String,
+    /// The file stem, used for output names.
+    pub name: String,
+    /// The source text.
+    pub source: String,
+    /// `[scene] title`.
+    pub title: Option<String>,
+    /// `[scene] description`.
+    pub description: Option<String>,
+    /// `[scene] reference`.
+    pub reference: Option<String>,
+    /// Parameters in file order.
+    pub params: IndexMap<String, Param>,
+    /// Named curves.
+    pub curves: IndexMap<String, FieldRef>,
+    /// Primary surfaces.
+    pub surfaces: Vec<SceneSurface>,
+    /// Patches in file order.
+    pub patches: Vec<ScenePatch>,
+    /// Picture settings.
+    pub render: RenderSettings,
+    /// Output formats (file extensions) for directory builds and the gallery.
+    pub formats: Vec<String>,
+}
+
+impl Scene {
+    /// Loads a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: file.clone(),
+            line: None,
+            column: None,
+            key: String::new(),
+            message: format!("cannot read the scene file: {e}"),
+            snippet: None,
+        })?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into());
+        Scene::parse(&text, &file, &name, &HashMap::new())
+    }
+
+    /// Parses scene text. `overrides` replace parameter values (by name) before anything
+    /// is resolved — the live editor's sliders.
+    pub fn parse(
+        text: &str,
+        file: &str,
+        name: &str,
+        overrides: &HashMap<String, f64>,
+    ) -> Result<Scene, SceneError> {
+        build::build(Source { file, text }, name, overrides)
+    }
+
+    /// The patch with the given name.
+    pub fn patch(&self, name: &str) -> Option<&ScenePatch> {
+        self.patches.iter().find(|p| p.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests;

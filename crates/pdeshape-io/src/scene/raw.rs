@@ -1,0 +1,167 @@
+//! The scene file as written: serde structures with source spans.
+
+use indexmap::IndexMap;
+use serde::Deserialize;
+use toml::Spanned;
+
+/// `[scene]`: free-text metadata.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawMeta {
+    pub title: Option<String>,
+    pub description: Option<String>,
+    /// Paper / figure this example reproduces.
+    pub reference: Option<String>,
+}
+
+/// A number or an expression text.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(untagged)]
+pub enum NumOrExpr {
+    Num(f64),
+    Expr(String),
+}
+
+/// `[parameters]` entry: `a = 1.5`, `b = "2*a"` or `c = { value = 1, min = 0, max = 2 }`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum RawParam {
+    Value(NumOrExpr),
+    Full(RawParamTable),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawParamTable {
+    pub value: NumOrExpr,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub step: Option<f64>,
+    pub description: Option<String>,
+}
+
+/// A v-domain: `"periodic"` or `[v0, v1]`.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(untagged)]
+pub enum RawDomain {
+    Word(String),
+    Range([NumOrExpr; 2]),
+}
+
+/// `[curves.NAME]`: exactly one of the source keys.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawCurve {
+    /// Three expressions in `v` (and `t`).
+    pub expr: Option<Spanned<[NumOrExpr; 3]>>,
+    /// Cubic B-spline control points.
+    pub bspline: Option<Spanned<Vec<[NumOrExpr; 3]>>>,
+    /// Polyline vertices.
+    pub polyline: Option<Spanned<Vec<[NumOrExpr; 3]>>>,
+    /// A single point (a pole).
+    pub point: Option<Spanned<[NumOrExpr; 3]>>,
+    /// A linear combination of other curves, e.g. `"alpha*(d1 - p2)"`.
+    pub combine: Option<Spanned<String>>,
+    /// A trimline of a primary surface: its name.
+    pub surface: Option<Spanned<String>>,
+    /// Trimline parameter `s₀`.
+    pub s: Option<Spanned<NumOrExpr>>,
+    /// Trimline cross-derivative order.
+    pub derivative: Option<Spanned<i64>>,
+    /// Trimline reparameterisation factor `ds/du`.
+    pub scale: Option<Spanned<NumOrExpr>>,
+    /// B-spline/polyline: closed (periodic) curve.
+    pub closed: Option<bool>,
+    /// B-spline degree (default 3).
+    pub degree: Option<Spanned<i64>>,
+    /// Parameter range of a B-spline/polyline (default `[0, 2π]` closed, `[0, 1]` open).
+    pub range: Option<Spanned<[NumOrExpr; 2]>>,
+}
+
+/// `[surfaces.NAME]`: a primary parametric surface `S(s, v, t)`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSurface {
+    pub expr: Spanned<[NumOrExpr; 3]>,
+    /// Range of `s` drawn in context (omit to hide the surface).
+    pub s_range: Option<Spanned<[NumOrExpr; 2]>>,
+    /// v domain (default periodic).
+    pub v: Option<Spanned<RawDomain>>,
+    /// Mesh resolution `[ns, nv]` for the context mesh.
+    pub resolution: Option<Spanned<[i64; 2]>>,
+}
+
+/// One condition of a patch.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCondition {
+    pub u: Spanned<NumOrExpr>,
+    #[serde(default)]
+    pub order: Option<Spanned<i64>>,
+    pub curve: Option<Spanned<String>>,
+    pub expr: Option<Spanned<[NumOrExpr; 3]>>,
+    pub point: Option<Spanned<[NumOrExpr; 3]>>,
+    /// Trimline of a primary surface: the surface name; `s` and `scale` as for curves.
+    pub surface: Option<Spanned<String>>,
+    pub s: Option<Spanned<NumOrExpr>>,
+    pub scale: Option<Spanned<NumOrExpr>>,
+}
+
+/// `[patches.NAME]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPatch {
+    pub kind: Spanned<String>,
+    /// v domain (default periodic).
+    pub v: Option<Spanned<RawDomain>>,
+    /// Mesh resolution `[nu, nv]` (vertices).
+    pub resolution: Option<Spanned<[i64; 2]>>,
+    pub conditions: Option<Spanned<Vec<Spanned<RawCondition>>>>,
+    /// Display colour `[r, g, b]` in 0…1.
+    pub color: Option<Spanned<[f64; 3]>>,
+}
+
+/// `[render]`: the picture.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawRender {
+    /// Camera azimuth in degrees (about +z).
+    pub azimuth: Option<f64>,
+    /// Camera elevation in degrees.
+    pub elevation: Option<f64>,
+    /// Image size in pixels.
+    pub size: Option<Spanned<[i64; 2]>>,
+    /// Draw the mesh lines.
+    pub wireframe: Option<bool>,
+    /// Colour the patches by this per-vertex field.
+    pub field: Option<String>,
+    /// Zoom factor (> 1 zooms in).
+    pub zoom: Option<f64>,
+}
+
+/// `[output]`: what `build` writes into a directory and `gallery` shows.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    pub formats: Option<Spanned<Vec<Spanned<String>>>>,
+}
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScene {
+    #[serde(default)]
+    pub scene: RawMeta,
+    #[serde(default)]
+    pub parameters: IndexMap<String, Spanned<RawParam>>,
+    #[serde(default)]
+    pub curves: IndexMap<String, Spanned<RawCurve>>,
+    #[serde(default)]
+    pub surfaces: IndexMap<String, Spanned<RawSurface>>,
+    #[serde(default)]
+    pub patches: IndexMap<String, Spanned<RawPatch>>,
+    #[serde(default)]
+    pub render: RawRender,
+    #[serde(default)]
+    pub output: RawOutput,
+}
