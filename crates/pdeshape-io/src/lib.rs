@@ -6,4 +6,6 @@
 #![warn(missing_docs)]
 
 pub mod export;
+pub mod model;
+pub mod render;
 pub mod scene;

@@ -1,3 +1,11 @@
+//! `pdeshape`: the command-line tool. A thin layer over `pdeshape-core` (mathematics) and
+//! `pdeshape-io` (scene files, exporters, pictures).
+
+mod cli;
+mod gallery;
+
+include!(concat!(env!("OUT_DIR"), "/examples.rs"));
+
 fn main() {
-    println!("Hello, world!");
+    std::process::exit(cli::run());
 }

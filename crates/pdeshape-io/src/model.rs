@@ -1,0 +1,127 @@
+//! From a resolved scene to meshes, pictures and diagnostics.
+
+use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
+use crate::scene::{RenderSettings, Scene, ScenePatch};
+use pdeshape_core::mesh::{GridOptions, Mesh, grid_mesh};
+use pdeshape_core::patch::{PrimarySurface, check_conditions};
+use serde_json::{Value, json};
+
+/// Number of `v` samples per condition in the exactness check (SPEC §3: ≥ 1000).
+pub const CHECK_SAMPLES: usize = 1000;
+
+/// Meshes one patch at its resolution, with its position conditions as highlighted
+/// curves. Fails when the patch is not finite somewhere.
+pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
+    let (nu, nv) = p.resolution;
+    let mut m = grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv))
+        .map_err(|e| format!("patch `{}`: {e}", p.name))?;
+    m.name = p.name.clone();
+    let dom = p.surface.v_domain();
+    let n = (4 * nv).max(64);
+    for c in p.conditions.iter().filter(|c| c.order == 0) {
+        let pts: Vec<_> = (0..=n)
+            .map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64)))
+            .collect();
+        m.curves.push(pts);
+    }
+    m.check_finite()?;
+    Ok(m)
+}
+
+/// Meshes of all patches, in scene order.
+pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
+    scene.patches.iter().map(patch_mesh).collect()
+}
+
+/// Meshes of the primary surfaces drawn in context (those with an `s_range`).
+pub fn context_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
+    let mut out = Vec::new();
+    for s in &scene.surfaces {
+        let Some(range) = s.s_range else { continue };
+        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, 0.0);
+        let mut m = grid_mesh(&ps, &GridOptions::new(s.resolution.0, s.resolution.1))
+            .map_err(|e| format!("surface `{}`: {e}", s.name))?;
+        m.name = format!("surface-{}", s.name);
+        m.check_finite()?;
+        out.push(m);
+    }
+    Ok(out)
+}
+
+/// Renders patches (coloured) with the context surfaces (neutral).
+pub fn render_meshes(
+    patches: &[Mesh],
+    context: &[Mesh],
+    colors: &[Option<[f64; 3]>],
+    r: &RenderSettings,
+) -> Image {
+    let mut items = Vec::new();
+    for m in context {
+        items.push(RenderItem {
+            mesh: m,
+            color: CONTEXT_COLOR,
+            field: None,
+            wireframe: false,
+        });
+    }
+    for (k, m) in patches.iter().enumerate() {
+        let color = colors
+            .get(k)
+            .copied()
+            .flatten()
+            .map(|c| c.map(|x| x as f32))
+            .unwrap_or(PALETTE[k % PALETTE.len()]);
+        items.push(RenderItem {
+            mesh: m,
+            color,
+            field: r.field.clone(),
+            wireframe: r.wireframe,
+        });
+    }
+    let cam = Camera {
+        azimuth: r.azimuth,
+        elevation: r.elevation,
+        zoom: r.zoom,
+        width: r.size.0,
+        height: r.size.1,
+    };
+    render(&items, &cam)
+}
+
+/// Renders the whole scene.
+pub fn render_scene(scene: &Scene) -> Result<Image, String> {
+    let patches = patch_meshes(scene)?;
+    let context = context_meshes(scene)?;
+    let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
+    Ok(render_meshes(&patches, &context, &colors, &scene.render))
+}
+
+/// Diagnostics of one patch, as `check --json` prints them.
+pub fn patch_diagnostics(p: &ScenePatch) -> Value {
+    let rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
+    let dom = p.surface.v_domain();
+    json!({
+        "name": p.name,
+        "kind": p.kind.name(),
+        "solver": match p.kind { crate::scene::PatchKind::Hermite => "hermite-interpolation" },
+        "conditions": p.conditions.iter().map(|c| json!({"u": c.u, "order": c.order})).collect::<Vec<_>>(),
+        "v_domain": {"start": dom.start, "end": dom.end, "periodic": dom.periodic},
+        "resolution": [p.resolution.0, p.resolution.1],
+        "condition_error": {
+            "samples": CHECK_SAMPLES,
+            "max_abs": rep.max_abs,
+            "max_rel": rep.max_rel,
+            "patch_size": rep.size,
+        },
+    })
+}
+
+/// Diagnostics of a scene.
+pub fn scene_diagnostics(scene: &Scene) -> Value {
+    json!({
+        "scene": scene.name,
+        "title": scene.title,
+        "parameters": scene.params.iter().map(|(k, p)| (k.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
+        "patches": scene.patches.iter().map(patch_diagnostics).collect::<Vec<_>>(),
+    })
+}

@@ -1,0 +1,407 @@
+//! Subcommands and exit codes: 0 ok, 1 runtime error, 2 usage error.
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::{Parser, Subcommand};
+use pdeshape_io::export::{Format, write_atomic, write_meshes};
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::collections::HashMap;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+/// PDE-based shape design: surfaces, blends, solids and trims as solutions of elliptic
+/// PDEs through boundary curves.
+#[derive(Parser, Debug)]
+#[command(name = "pdeshape", version, about, long_about = None)]
+pub struct Cli {
+    /// Print nothing but errors (no progress bars).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Build a scene into meshes: OUT with a mesh extension (obj, ply, stl, glb, vtu) gets
+    /// every patch as a group; OUT ending in .png gets a picture; any other OUT is a
+    /// directory that receives one file per patch and format of the scene's [output].
+    Build {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output file or directory.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Override a parameter: NAME=VALUE (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+    /// Diagnose a scene: solver, condition errors, conditioning.
+    Check {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Override a parameter: NAME=VALUE (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+    /// Evaluate a patch at parameters read as CSV `u,v` from stdin; writes `u,v,x,y,z`.
+    Sample {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Patch to evaluate (default: the first).
+        #[arg(long)]
+        patch: Option<String>,
+        /// Time, for dynamic blends.
+        #[arg(long)]
+        time: Option<f64>,
+        /// Override a parameter: NAME=VALUE (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+    /// Render a scene to PNG.
+    Render {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Image width in pixels.
+        #[arg(long)]
+        width: Option<u32>,
+        /// Image height in pixels.
+        #[arg(long)]
+        height: Option<u32>,
+        /// Camera azimuth (degrees).
+        #[arg(long, allow_hyphen_values = true)]
+        azimuth: Option<f64>,
+        /// Camera elevation (degrees).
+        #[arg(long, allow_hyphen_values = true)]
+        elevation: Option<f64>,
+        /// Draw mesh lines.
+        #[arg(long)]
+        wireframe: bool,
+        /// Override a parameter: NAME=VALUE (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+    /// Build every built-in example into DIR: meshes, pictures and index.html.
+    Gallery {
+        /// Output directory.
+        #[arg(default_value = "gallery")]
+        dir: PathBuf,
+    },
+    /// Reproduce the papers' timing tables.
+    Bench,
+    /// Serve the interactive editor on localhost.
+    Serve {
+        /// Scene to open.
+        scene: Option<PathBuf>,
+    },
+}
+
+/// Parses the arguments, runs, and returns the exit code.
+pub fn run() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    match execute(cli) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            1
+        }
+    }
+}
+
+fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
+    let mut m = HashMap::new();
+    for s in set {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| anyhow!("--set {s:?}: expected NAME=VALUE"))?;
+        let x: f64 = v
+            .trim()
+            .parse()
+            .map_err(|_| anyhow!("--set {s:?}: `{v}` is not a number"))?;
+        if !x.is_finite() {
+            bail!("--set {s:?}: the value is not finite");
+        }
+        m.insert(k.trim().to_string(), x);
+    }
+    Ok(m)
+}
+
+pub fn load(path: &Path, set: &[String]) -> Result<Scene> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read the scene file {}", path.display()))?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    Ok(Scene::parse(
+        &text,
+        &path.display().to_string(),
+        &name,
+        &overrides(set)?,
+    )?)
+}
+
+fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
+    write_atomic(path, |w| img.write_png(w))
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes the scene's outputs into a directory: one file per patch and format, plus
+/// `NAME.png` for the picture. Returns the files written.
+pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the directory {}", dir.display()))?;
+    let meshes = model::patch_meshes(scene).map_err(|e| anyhow!(e))?;
+    let mut written = Vec::new();
+    for f in &scene.formats {
+        if f == "png" {
+            let context = model::context_meshes(scene).map_err(|e| anyhow!(e))?;
+            let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
+            let img = model::render_meshes(&meshes, &context, &colors, &scene.render);
+            let path = dir.join(format!("{}.png", scene.name));
+            write_png(&path, &img)?;
+            written.push(path);
+            continue;
+        }
+        let fmt = Format::from_extension(f).ok_or_else(|| anyhow!("unknown format `{f}`"))?;
+        for m in &meshes {
+            let path = dir.join(format!("{}-{}.{}", scene.name, m.name, fmt.extension()));
+            write_meshes(&path, fmt, &[m])
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+fn execute(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Build { scene, out, set } => {
+            let sc = load(&scene, &set)?;
+            let ext = out
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or("")
+                .to_ascii_lowercase();
+            if ext == "png" {
+                let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
+                write_png(&out, &img)?;
+                if !cli.quiet {
+                    eprintln!("wrote {}", out.display());
+                }
+            } else if let Some(fmt) = Format::from_extension(&ext) {
+                let meshes = model::patch_meshes(&sc).map_err(|e| anyhow!(e))?;
+                let refs: Vec<_> = meshes.iter().collect();
+                write_meshes(&out, fmt, &refs)
+                    .with_context(|| format!("cannot write {}", out.display()))?;
+                if !cli.quiet {
+                    let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
+                    eprintln!(
+                        "wrote {} ({} patches, {nv} vertices)",
+                        out.display(),
+                        meshes.len()
+                    );
+                }
+            } else if !ext.is_empty() {
+                bail!(
+                    "unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)"
+                );
+            } else {
+                let files = build_into_dir(&sc, &out)?;
+                if !cli.quiet {
+                    for f in files {
+                        eprintln!("wrote {}", f.display());
+                    }
+                }
+            }
+            if !cli.quiet {
+                for p in &sc.patches {
+                    let d = model::patch_diagnostics(p);
+                    eprintln!(
+                        "patch {}: {} ({}), max condition error {:.2e} (relative)",
+                        p.name,
+                        d["kind"].as_str().unwrap_or(""),
+                        d["solver"].as_str().unwrap_or(""),
+                        d["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Check { scene, json, set } => {
+            let sc = load(&scene, &set)?;
+            let d = model::scene_diagnostics(&sc);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&d)?);
+            } else {
+                println!(
+                    "scene {}{}",
+                    sc.name,
+                    sc.title
+                        .as_ref()
+                        .map(|t| format!(": {t}"))
+                        .unwrap_or_default()
+                );
+                for p in d["patches"].as_array().into_iter().flatten() {
+                    println!(
+                        "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
+                        p["name"].as_str().unwrap_or(""),
+                        p["kind"].as_str().unwrap_or(""),
+                        p["solver"].as_str().unwrap_or(""),
+                        p["conditions"].as_array().map(|a| a.len()).unwrap_or(0),
+                        p["condition_error"]["max_abs"].as_f64().unwrap_or(f64::NAN),
+                        p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN),
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Sample {
+            scene,
+            patch,
+            time,
+            set,
+        } => {
+            let sc = load(&scene, &set)?;
+            let p = match &patch {
+                Some(n) => sc.patch(n).ok_or_else(|| {
+                    anyhow!(
+                        "no patch named `{n}` in {} (patches: {})",
+                        sc.file,
+                        sc.patches
+                            .iter()
+                            .map(|p| p.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                })?,
+                None => sc
+                    .patches
+                    .first()
+                    .ok_or_else(|| anyhow!("the scene {} has no patches", sc.file))?,
+            };
+            if let Some(t) = time {
+                if !t.is_finite() {
+                    bail!("--time {t} is not finite");
+                }
+                if t != 0.0 && p.conditions.iter().all(|c| c.data.is_constant_in(1)) {
+                    eprintln!("note: patch `{}` does not depend on time", p.name);
+                }
+            }
+            sample(p, time.unwrap_or(0.0))
+        }
+        Command::Render {
+            scene,
+            out,
+            width,
+            height,
+            azimuth,
+            elevation,
+            wireframe,
+            set,
+        } => {
+            let mut sc = load(&scene, &set)?;
+            if let Some(w) = width {
+                sc.render.size.0 = w.clamp(16, 8192);
+            }
+            if let Some(h) = height {
+                sc.render.size.1 = h.clamp(16, 8192);
+            }
+            if let Some(a) = azimuth {
+                sc.render.azimuth = a;
+            }
+            if let Some(e) = elevation {
+                sc.render.elevation = e.clamp(-90.0, 90.0);
+            }
+            sc.render.wireframe |= wireframe;
+            let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
+            write_png(&out, &img)?;
+            if !cli.quiet {
+                eprintln!("wrote {}", out.display());
+            }
+            Ok(())
+        }
+        Command::Gallery { dir } => crate::gallery::run(&dir, cli.quiet),
+        Command::Bench => bail!(
+            "`pdeshape bench` is not available in this version: the papers' solvers it times are not implemented yet"
+        ),
+        Command::Serve { .. } => bail!(
+            "`pdeshape serve` is not available in this version: the web editor is not implemented yet"
+        ),
+    }
+}
+
+fn sample(p: &pdeshape_io::scene::ScenePatch, t: f64) -> Result<()> {
+    let _ = t; // static patches ignore time; dynamic ones will use it
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    let dom = p.surface.v_domain();
+    writeln!(out, "u,v,x,y,z")?;
+    for (ln, line) in stdin.lock().lines().enumerate() {
+        let line = line.context("cannot read stdin")?;
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
+        if ln == 0 && cols.first().is_some_and(|c| c.parse::<f64>().is_err()) {
+            continue; // header
+        }
+        if cols.len() != 2 {
+            bail!(
+                "stdin line {}: expected 2 columns `u,v`, got {}: {l:?}",
+                ln + 1,
+                cols.len()
+            );
+        }
+        let mut vals = [0.0f64; 2];
+        for (k, c) in cols.iter().enumerate() {
+            vals[k] = c
+                .parse()
+                .map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
+            if !vals[k].is_finite() {
+                bail!("stdin line {}: `{c}` is not finite", ln + 1);
+            }
+        }
+        let [u, v] = vals;
+        if !(0.0..=1.0).contains(&u) {
+            bail!("stdin line {}: u = {u} is outside [0, 1]", ln + 1);
+        }
+        if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
+            bail!(
+                "stdin line {}: v = {v} is outside [{}, {}]",
+                ln + 1,
+                dom.start,
+                dom.end
+            );
+        }
+        let x = p.surface.point(u, v);
+        if !x.is_finite() {
+            bail!(
+                "stdin line {}: the patch is not finite at (u, v) = ({u}, {v})",
+                ln + 1
+            );
+        }
+        writeln!(
+            out,
+            "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}",
+            x.x, x.y, x.z
+        )?;
+    }
+    out.flush()?;
+    Ok(())
+}

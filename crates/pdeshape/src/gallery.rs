@@ -1,0 +1,169 @@
+//! `pdeshape gallery`: every built-in example built into a directory with an HTML index.
+
+use crate::EXAMPLES;
+use anyhow::{Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+struct Entry {
+    name: String,
+    title: String,
+    description: String,
+    reference: String,
+    picture: Option<String>,
+    files: Vec<String>,
+    diagnostics: String,
+    error: Option<String>,
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
+    let mut e = Entry {
+        name: name.to_string(),
+        title: name.to_string(),
+        description: String::new(),
+        reference: String::new(),
+        picture: None,
+        files: Vec::new(),
+        diagnostics: String::new(),
+        error: None,
+    };
+    let scene = match Scene::parse(
+        text,
+        &format!("examples/{name}.toml"),
+        name,
+        &HashMap::new(),
+    ) {
+        Ok(s) => s,
+        Err(err) => {
+            e.error = Some(err.to_string());
+            return e;
+        }
+    };
+    e.title = scene.title.clone().unwrap_or_else(|| name.to_string());
+    e.description = scene.description.clone().unwrap_or_default();
+    e.reference = scene.reference.clone().unwrap_or_default();
+    let sub = dir.join(name);
+    match crate::cli::build_into_dir(&scene, &sub) {
+        Ok(files) => {
+            for f in files {
+                let rel = format!(
+                    "{name}/{}",
+                    f.file_name()
+                        .map(|s| s.to_string_lossy().into_owned())
+                        .unwrap_or_default()
+                );
+                if rel.ends_with(".png") {
+                    e.picture = Some(rel);
+                } else {
+                    e.files.push(rel);
+                }
+            }
+        }
+        Err(err) => {
+            e.error = Some(format!("{err:#}"));
+            return e;
+        }
+    }
+    let d = model::scene_diagnostics(&scene);
+    let mut t = String::from(
+        "<table><tr><th>patch</th><th>kind</th><th>solver</th><th>max condition error (rel.)</th></tr>",
+    );
+    for p in d["patches"].as_array().into_iter().flatten() {
+        let _ = write!(
+            t,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2e}</td></tr>",
+            esc(p["name"].as_str().unwrap_or("")),
+            esc(p["kind"].as_str().unwrap_or("")),
+            esc(p["solver"].as_str().unwrap_or("")),
+            p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
+        );
+    }
+    t.push_str("</table>");
+    e.diagnostics = t;
+    e
+}
+
+/// Builds the gallery; fails (after building the rest) when any example fails.
+pub fn run(dir: &Path, quiet: bool) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(EXAMPLES.len() as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut entries = Vec::new();
+    for (name, text) in EXAMPLES {
+        bar.set_message(name.to_string());
+        entries.push(build_one(name, text, dir));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let mut html = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>pdeshape gallery</title><style>\
+         body{font-family:system-ui,sans-serif;margin:2em;background:#f6f7f9;color:#222}\
+         .card{background:#fff;border-radius:8px;padding:1em;margin:0 0 1.5em;box-shadow:0 1px 3px #0002}\
+         img{max-width:100%;border:1px solid #ddd}table{border-collapse:collapse;margin-top:.5em}\
+         td,th{border:1px solid #ccc;padding:2px 8px;font-size:90%}.err{color:#a00;white-space:pre-wrap}\
+         </style></head><body><h1>pdeshape gallery</h1>\n",
+    );
+    for e in &entries {
+        let _ = write!(
+            html,
+            "<div class=\"card\" id=\"{0}\"><h2>{1}</h2><p><code>examples/{0}.toml</code>",
+            esc(&e.name),
+            esc(&e.title)
+        );
+        if !e.reference.is_empty() {
+            let _ = write!(html, " — {}", esc(&e.reference));
+        }
+        let _ = write!(html, "</p><p>{}</p>", esc(&e.description));
+        if let Some(p) = &e.picture {
+            let _ = write!(html, "<img src=\"{}\" alt=\"{}\">", esc(p), esc(&e.title));
+        }
+        if let Some(err) = &e.error {
+            let _ = write!(html, "<p class=\"err\">{}</p>", esc(err));
+        }
+        html.push_str(&e.diagnostics);
+        if !e.files.is_empty() {
+            html.push_str("<p>");
+            for f in &e.files {
+                let _ = write!(html, "<a href=\"{0}\">{0}</a> ", esc(f));
+            }
+            html.push_str("</p>");
+        }
+        html.push_str("</div>\n");
+    }
+    html.push_str("</body></html>\n");
+    let index = dir.join("index.html");
+    pdeshape_io::export::write_atomic(&index, |w| w.write_all(html.as_bytes()))?;
+    let failed: Vec<_> = entries.iter().filter(|e| e.error.is_some()).collect();
+    if !quiet {
+        eprintln!("gallery: {} examples → {}", entries.len(), index.display());
+    }
+    if !failed.is_empty() {
+        for e in &failed {
+            eprintln!(
+                "example {} failed: {}",
+                e.name,
+                e.error.as_deref().unwrap_or("")
+            );
+        }
+        bail!("{} of {} examples failed", failed.len(), entries.len());
+    }
+    Ok(())
+}
