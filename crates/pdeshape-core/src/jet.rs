@@ -36,10 +36,7 @@ impl JetShape {
     /// A shape keeping derivatives up to `orders[k]` in variable `k` (at most three variables;
     /// missing variables get order 0).
     pub fn new(orders: &[usize]) -> Self {
-        assert!(
-            orders.len() <= MAX_VARS,
-            "a jet has at most {MAX_VARS} variables"
-        );
+        assert!(orders.len() <= MAX_VARS, "a jet has at most {MAX_VARS} variables");
         let mut o = [0; MAX_VARS];
         o[..orders.len()].copy_from_slice(orders);
         JetShape { orders: o }
@@ -47,9 +44,7 @@ impl JetShape {
 
     /// The shape of a plain value (no derivatives).
     pub const fn scalar() -> Self {
-        JetShape {
-            orders: [0; MAX_VARS],
-        }
+        JetShape { orders: [0; MAX_VARS] }
     }
 
     /// Per-variable truncation orders.
@@ -146,21 +141,13 @@ impl Jet {
 
     /// The Taylor coefficient of multi-index `m` (zero outside the shape).
     pub fn coeff(&self, m: [usize; MAX_VARS]) -> f64 {
-        if self.shape.contains(m) {
-            self.c[self.shape.index(m)]
-        } else {
-            0.0
-        }
+        if self.shape.contains(m) { self.c[self.shape.index(m)] } else { 0.0 }
     }
 
     /// The partial derivative `∂^{i+j+k} f/∂x₀^i ∂x₁^j ∂x₂^k`, exact; zero outside the shape
     /// is *not* implied, so asking for one is a logic error and panics.
     pub fn derivative(&self, m: [usize; MAX_VARS]) -> f64 {
-        assert!(
-            self.shape.contains(m),
-            "derivative {m:?} outside jet shape {:?}",
-            self.shape
-        );
+        assert!(self.shape.contains(m), "derivative {m:?} outside jet shape {:?}", self.shape);
         self.c[self.shape.index(m)] * m.iter().map(|&k| factorial(k)).product::<f64>()
     }
 
@@ -176,10 +163,7 @@ impl Jet {
 
     fn zip(&self, o: &Jet, f: impl Fn(f64, f64) -> f64) -> Jet {
         assert_eq!(self.shape, o.shape, "jets of different shapes");
-        Jet {
-            shape: self.shape,
-            c: self.c.iter().zip(&o.c).map(|(a, b)| f(*a, *b)).collect(),
-        }
+        Jet { shape: self.shape, c: self.c.iter().zip(&o.c).map(|(a, b)| f(*a, *b)).collect() }
     }
 
     /// `a + b`.
@@ -199,10 +183,7 @@ impl Jet {
 
     /// `s·a` for a number `s`.
     pub fn scale(&self, s: f64) -> Jet {
-        Jet {
-            shape: self.shape,
-            c: self.c.iter().map(|a| a * s).collect(),
-        }
+        Jet { shape: self.shape, c: self.c.iter().map(|a| a * s).collect() }
     }
 
     /// `a + s` for a number `s`.
@@ -242,10 +223,7 @@ impl Jet {
                 }
             }
         }
-        Jet {
-            shape: self.shape,
-            c: out,
-        }
+        Jet { shape: self.shape, c: out }
     }
 
     /// `f(a)` for an analytic `f` given by `taylor[k] = f⁽ᵏ⁾(a₀)/k!`, `k = 0 … K`
@@ -277,9 +255,7 @@ impl Jet {
     pub fn sin(&self) -> Jet {
         let (s, c) = self.value().sin_cos();
         let cyc = [s, c, -s, -c];
-        let t: Vec<f64> = (0..=self.k_max())
-            .map(|k| cyc[k % 4] / factorial(k))
-            .collect();
+        let t: Vec<f64> = (0..=self.k_max()).map(|k| cyc[k % 4] / factorial(k)).collect();
         self.compose(&t)
     }
 
@@ -287,36 +263,29 @@ impl Jet {
     pub fn cos(&self) -> Jet {
         let (s, c) = self.value().sin_cos();
         let cyc = [c, -s, -c, s];
-        let t: Vec<f64> = (0..=self.k_max())
-            .map(|k| cyc[k % 4] / factorial(k))
-            .collect();
+        let t: Vec<f64> = (0..=self.k_max()).map(|k| cyc[k % 4] / factorial(k)).collect();
         self.compose(&t)
     }
 
     /// `sinh a`.
     pub fn sinh(&self) -> Jet {
         let (s, c) = (self.value().sinh(), self.value().cosh());
-        let t: Vec<f64> = (0..=self.k_max())
-            .map(|k| if k % 2 == 0 { s } else { c } / factorial(k))
-            .collect();
+        let t: Vec<f64> = (0..=self.k_max()).map(|k| if k % 2 == 0 { s } else { c } / factorial(k)).collect();
         self.compose(&t)
     }
 
     /// `cosh a`.
     pub fn cosh(&self) -> Jet {
         let (s, c) = (self.value().sinh(), self.value().cosh());
-        let t: Vec<f64> = (0..=self.k_max())
-            .map(|k| if k % 2 == 0 { c } else { s } / factorial(k))
-            .collect();
+        let t: Vec<f64> = (0..=self.k_max()).map(|k| if k % 2 == 0 { c } else { s } / factorial(k)).collect();
         self.compose(&t)
     }
 
     /// `1/a`: Taylor coefficients `(−1)ᵏ / a₀^{k+1}`.
     pub fn recip(&self) -> Jet {
         let a = self.value();
-        let t: Vec<f64> = (0..=self.k_max())
-            .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 } / a.powi(k as i32 + 1))
-            .collect();
+        let t: Vec<f64> =
+            (0..=self.k_max()).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 } / a.powi(k as i32 + 1)).collect();
         self.compose(&t)
     }
 
@@ -385,11 +354,7 @@ impl Jet {
 
     /// `aᵇ` for jets: `powf` when `b` is constant, else `exp(b ln a)`.
     pub fn pow(&self, b: &Jet) -> Jet {
-        if b.is_constant() {
-            self.powf(b.value())
-        } else {
-            b.mul(&self.ln()).exp()
-        }
+        if b.is_constant() { self.powf(b.value()) } else { b.mul(&self.ln()).exp() }
     }
 
     /// `√a`.
@@ -409,11 +374,7 @@ impl Jet {
 
     /// `|a|`, differentiated on the side of the sign of `a₀`.
     pub fn abs(&self) -> Jet {
-        if self.value() < 0.0 {
-            self.neg()
-        } else {
-            self.clone()
-        }
+        if self.value() < 0.0 { self.neg() } else { self.clone() }
     }
 
     /// The argument of `(x, y)`: `atan2(y, x)`.
@@ -446,20 +407,12 @@ impl Jet {
 
     /// `min(a, b)`, choosing the branch by value (ties: `a`).
     pub fn min(&self, o: &Jet) -> Jet {
-        if o.value() < self.value() {
-            o.clone()
-        } else {
-            self.clone()
-        }
+        if o.value() < self.value() { o.clone() } else { self.clone() }
     }
 
     /// `max(a, b)`, choosing the branch by value (ties: `a`).
     pub fn max(&self, o: &Jet) -> Jet {
-        if o.value() > self.value() {
-            o.clone()
-        } else {
-            self.clone()
-        }
+        if o.value() > self.value() { o.clone() } else { self.clone() }
     }
 }
 
@@ -479,37 +432,21 @@ mod tests {
         // exp(2x): 2^k e^{2x}
         let f = x.scale(2.0).exp();
         for k in 0..=6 {
-            assert!(close(
-                f.derivative([k, 0, 0]),
-                2f64.powi(k as i32) * (2.0 * x0).exp(),
-                1e-13
-            ));
+            assert!(close(f.derivative([k, 0, 0]), 2f64.powi(k as i32) * (2.0 * x0).exp(), 1e-13));
         }
         // ln x: (-1)^{k-1}(k-1)!/x^k
         let f = x.ln();
         for k in 1..=6 {
             let s = if k % 2 == 1 { 1.0 } else { -1.0 };
-            assert!(close(
-                f.derivative([k, 0, 0]),
-                s * factorial(k - 1) / x0.powi(k as i32),
-                1e-12
-            ));
+            assert!(close(f.derivative([k, 0, 0]), s * factorial(k - 1) / x0.powi(k as i32), 1e-12));
         }
         // tan' = 1 + tan², tan'' = 2 tan (1 + tan²)
         let f = x.tan();
         let t = x0.tan();
         assert!(close(f.derivative([1, 0, 0]), 1.0 + t * t, 1e-13));
-        assert!(close(
-            f.derivative([2, 0, 0]),
-            2.0 * t * (1.0 + t * t),
-            1e-13
-        ));
+        assert!(close(f.derivative([2, 0, 0]), 2.0 * t * (1.0 + t * t), 1e-13));
         // sqrt: d³ = 3/8 x^{-5/2}
-        assert!(close(
-            x.sqrt().derivative([3, 0, 0]),
-            0.375 * x0.powf(-2.5),
-            1e-13
-        ));
+        assert!(close(x.sqrt().derivative([3, 0, 0]), 0.375 * x0.powf(-2.5), 1e-13));
         // tanh' = 1 - tanh²
         let th = x0.tanh();
         assert!(close(x.tanh().derivative([1, 0, 0]), 1.0 - th * th, 1e-13));
@@ -525,11 +462,7 @@ mod tests {
         let f = x.sin().mul(&y.exp()).mul(&z.powi(2));
         let expect = -(0.3f64.sin()) * (-0.2f64).exp() * 2.0;
         assert!(close(f.derivative([2, 1, 2]), expect, 1e-13));
-        assert!(close(
-            f.derivative([3, 2, 1]),
-            -(0.3f64.cos()) * (-0.2f64).exp() * 3.0,
-            1e-13
-        ));
+        assert!(close(f.derivative([3, 2, 1]), -(0.3f64.cos()) * (-0.2f64).exp() * 3.0, 1e-13));
     }
 
     #[test]
@@ -560,10 +493,6 @@ mod tests {
         // general power through exp/ln: (y)^(x) with x a jet
         let f = y.pow(&x);
         // ∂/∂x y^x = ln(y) y^x
-        assert!(close(
-            f.derivative([1, 0, 0]),
-            0.8f64.ln() * 0.8f64.powf(-1.3),
-            1e-13
-        ));
+        assert!(close(f.derivative([1, 0, 0]), 0.8f64.ln() * 0.8f64.powf(-1.3), 1e-13));
     }
 }

@@ -29,9 +29,7 @@ pub fn condition_number(a: &Mat<f64>) -> Result<f64, LinalgError> {
     if !(0..a.nrows()).all(|i| (0..a.ncols()).all(|j| a[(i, j)].is_finite())) {
         return Err(LinalgError::NonFinite);
     }
-    let s = a
-        .singular_values()
-        .map_err(|_| LinalgError::NoConvergence)?;
+    let s = a.singular_values().map_err(|_| LinalgError::NoConvergence)?;
     let max = s.iter().cloned().fold(0.0, f64::max);
     let min = s.iter().cloned().fold(f64::INFINITY, f64::min);
     Ok(if min > 0.0 { max / min } else { f64::INFINITY })
@@ -51,10 +49,7 @@ impl SquareSolver {
         if cond.is_nan() || cond > max_cond {
             return Err(LinalgError::Singular { cond });
         }
-        Ok(SquareSolver {
-            lu: a.full_piv_lu(),
-            cond,
-        })
+        Ok(SquareSolver { lu: a.full_piv_lu(), cond })
     }
 
     /// The 2-norm condition number of the factorized matrix.
@@ -70,11 +65,7 @@ impl SquareSolver {
 
 /// Solves the least-squares problem `min ‖A x − b‖₂` for every column of `b` by QR with
 /// column pivoting; returns the solution and the condition number of `A`.
-pub fn least_squares(
-    a: &Mat<f64>,
-    b: &Mat<f64>,
-    max_cond: f64,
-) -> Result<(Mat<f64>, f64), LinalgError> {
+pub fn least_squares(a: &Mat<f64>, b: &Mat<f64>, max_cond: f64) -> Result<(Mat<f64>, f64), LinalgError> {
     use faer::linalg::solvers::SolveLstsq;
     let cond = condition_number(a)?;
     if cond.is_nan() || cond > max_cond {
@@ -98,10 +89,7 @@ mod tests {
         assert!(r.norm_max() < 1e-14);
         assert!((s.cond() - 3.0 / 1.5).abs() < 1e-12);
         let sing = Mat::from_fn(2, 2, |_, _| 1.0);
-        assert!(matches!(
-            SquareSolver::new(&sing, 1e12),
-            Err(LinalgError::Singular { .. })
-        ));
+        assert!(matches!(SquareSolver::new(&sing, 1e12), Err(LinalgError::Singular { .. })));
     }
 
     #[test]

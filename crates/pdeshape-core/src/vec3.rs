@@ -23,11 +23,7 @@ pub struct Vec3 {
 
 impl Vec3 {
     /// The zero vector.
-    pub const ZERO: Vec3 = Vec3 {
-        x: 0.0,
-        y: 0.0,
-        z: 0.0,
-    };
+    pub const ZERO: Vec3 = Vec3 { x: 0.0, y: 0.0, z: 0.0 };
 
     /// Creates a vector from its components.
     #[inline]
@@ -38,11 +34,7 @@ impl Vec3 {
     /// Creates a vector from an array `[x, y, z]`.
     #[inline]
     pub const fn from_array(a: [f64; 3]) -> Self {
-        Vec3 {
-            x: a[0],
-            y: a[1],
-            z: a[2],
-        }
+        Vec3 { x: a[0], y: a[1], z: a[2] }
     }
 
     /// The components as an array `[x, y, z]`.
@@ -60,11 +52,7 @@ impl Vec3 {
     /// Cross product `a×b`.
     #[inline]
     pub fn cross(self, o: Vec3) -> Vec3 {
-        Vec3::new(
-            self.y * o.z - self.z * o.y,
-            self.z * o.x - self.x * o.z,
-            self.x * o.y - self.y * o.x,
-        )
+        Vec3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
     }
 
     /// Euclidean length `|a|`.

@@ -13,15 +13,13 @@ pub const CHECK_SAMPLES: usize = 1000;
 /// curves. Fails when the patch is not finite somewhere.
 pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     let (nu, nv) = p.resolution;
-    let mut m = grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv))
-        .map_err(|e| format!("patch `{}`: {e}", p.name))?;
+    let mut m =
+        grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
     m.name = p.name.clone();
     let dom = p.surface.v_domain();
     let n = (4 * nv).max(64);
     for c in p.conditions.iter().filter(|c| c.order == 0) {
-        let pts: Vec<_> = (0..=n)
-            .map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64)))
-            .collect();
+        let pts: Vec<_> = (0..=n).map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64))).collect();
         m.curves.push(pts);
     }
     m.check_finite()?;
@@ -49,42 +47,16 @@ pub fn context_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
 }
 
 /// Renders patches (coloured) with the context surfaces (neutral).
-pub fn render_meshes(
-    patches: &[Mesh],
-    context: &[Mesh],
-    colors: &[Option<[f64; 3]>],
-    r: &RenderSettings,
-) -> Image {
+pub fn render_meshes(patches: &[Mesh], context: &[Mesh], colors: &[Option<[f64; 3]>], r: &RenderSettings) -> Image {
     let mut items = Vec::new();
     for m in context {
-        items.push(RenderItem {
-            mesh: m,
-            color: CONTEXT_COLOR,
-            field: None,
-            wireframe: false,
-        });
+        items.push(RenderItem { mesh: m, color: CONTEXT_COLOR, field: None, wireframe: false });
     }
     for (k, m) in patches.iter().enumerate() {
-        let color = colors
-            .get(k)
-            .copied()
-            .flatten()
-            .map(|c| c.map(|x| x as f32))
-            .unwrap_or(PALETTE[k % PALETTE.len()]);
-        items.push(RenderItem {
-            mesh: m,
-            color,
-            field: r.field.clone(),
-            wireframe: r.wireframe,
-        });
+        let color = colors.get(k).copied().flatten().map(|c| c.map(|x| x as f32)).unwrap_or(PALETTE[k % PALETTE.len()]);
+        items.push(RenderItem { mesh: m, color, field: r.field.clone(), wireframe: r.wireframe });
     }
-    let cam = Camera {
-        azimuth: r.azimuth,
-        elevation: r.elevation,
-        zoom: r.zoom,
-        width: r.size.0,
-        height: r.size.1,
-    };
+    let cam = Camera { azimuth: r.azimuth, elevation: r.elevation, zoom: r.zoom, width: r.size.0, height: r.size.1 };
     render(&items, &cam)
 }
 

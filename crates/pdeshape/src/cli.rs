@@ -124,13 +124,8 @@ pub fn run() -> i32 {
 fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
     let mut m = HashMap::new();
     for s in set {
-        let (k, v) = s
-            .split_once('=')
-            .ok_or_else(|| anyhow!("--set {s:?}: expected NAME=VALUE"))?;
-        let x: f64 = v
-            .trim()
-            .parse()
-            .map_err(|_| anyhow!("--set {s:?}: `{v}` is not a number"))?;
+        let (k, v) = s.split_once('=').ok_or_else(|| anyhow!("--set {s:?}: expected NAME=VALUE"))?;
+        let x: f64 = v.trim().parse().map_err(|_| anyhow!("--set {s:?}: `{v}` is not a number"))?;
         if !x.is_finite() {
             bail!("--set {s:?}: the value is not finite");
         }
@@ -140,30 +135,20 @@ fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
 }
 
 pub fn load(path: &Path, set: &[String]) -> Result<Scene> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the scene file {}", path.display()))?;
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".into());
-    Ok(Scene::parse(
-        &text,
-        &path.display().to_string(),
-        &name,
-        &overrides(set)?,
-    )?)
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {}", path.display()))?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    Ok(Scene::parse(&text, &path.display().to_string(), &name, &overrides(set)?)?)
 }
 
 fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
-    write_atomic(path, |w| img.write_png(w))
-        .with_context(|| format!("cannot write {}", path.display()))
+    write_atomic(path, |w| img.write_png(w)).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Writes the scene's outputs into a directory: one file per patch and format, plus
 /// `NAME.png` for the picture. Returns the files written.
 pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the directory {}", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create the directory {}", dir.display()))?;
     let meshes = model::patch_meshes(scene).map_err(|e| anyhow!(e))?;
     let mut written = Vec::new();
     for f in &scene.formats {
@@ -179,8 +164,7 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
         let fmt = Format::from_extension(f).ok_or_else(|| anyhow!("unknown format `{f}`"))?;
         for m in &meshes {
             let path = dir.join(format!("{}-{}.{}", scene.name, m.name, fmt.extension()));
-            write_meshes(&path, fmt, &[m])
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            write_meshes(&path, fmt, &[m]).with_context(|| format!("cannot write {}", path.display()))?;
             written.push(path);
         }
     }
@@ -191,11 +175,7 @@ fn execute(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Build { scene, out, set } => {
             let sc = load(&scene, &set)?;
-            let ext = out
-                .extension()
-                .and_then(|e| e.to_str())
-                .unwrap_or("")
-                .to_ascii_lowercase();
+            let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
             if ext == "png" {
                 let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
                 write_png(&out, &img)?;
@@ -205,20 +185,13 @@ fn execute(cli: Cli) -> Result<()> {
             } else if let Some(fmt) = Format::from_extension(&ext) {
                 let meshes = model::patch_meshes(&sc).map_err(|e| anyhow!(e))?;
                 let refs: Vec<_> = meshes.iter().collect();
-                write_meshes(&out, fmt, &refs)
-                    .with_context(|| format!("cannot write {}", out.display()))?;
+                write_meshes(&out, fmt, &refs).with_context(|| format!("cannot write {}", out.display()))?;
                 if !cli.quiet {
                     let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
-                    eprintln!(
-                        "wrote {} ({} patches, {nv} vertices)",
-                        out.display(),
-                        meshes.len()
-                    );
+                    eprintln!("wrote {} ({} patch{}, {nv} vertices)", out.display(), meshes.len(), if meshes.len() == 1 { "" } else { "es" });
                 }
             } else if !ext.is_empty() {
-                bail!(
-                    "unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)"
-                );
+                bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)");
             } else {
                 let files = build_into_dir(&sc, &out)?;
                 if !cli.quiet {
@@ -247,14 +220,7 @@ fn execute(cli: Cli) -> Result<()> {
             if json {
                 println!("{}", serde_json::to_string_pretty(&d)?);
             } else {
-                println!(
-                    "scene {}{}",
-                    sc.name,
-                    sc.title
-                        .as_ref()
-                        .map(|t| format!(": {t}"))
-                        .unwrap_or_default()
-                );
+                println!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
                 for p in d["patches"].as_array().into_iter().flatten() {
                     println!(
                         "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
@@ -269,29 +235,17 @@ fn execute(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Sample {
-            scene,
-            patch,
-            time,
-            set,
-        } => {
+        Command::Sample { scene, patch, time, set } => {
             let sc = load(&scene, &set)?;
             let p = match &patch {
                 Some(n) => sc.patch(n).ok_or_else(|| {
                     anyhow!(
                         "no patch named `{n}` in {} (patches: {})",
                         sc.file,
-                        sc.patches
-                            .iter()
-                            .map(|p| p.name.as_str())
-                            .collect::<Vec<_>>()
-                            .join(", ")
+                        sc.patches.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
                     )
                 })?,
-                None => sc
-                    .patches
-                    .first()
-                    .ok_or_else(|| anyhow!("the scene {} has no patches", sc.file))?,
+                None => sc.patches.first().ok_or_else(|| anyhow!("the scene {} has no patches", sc.file))?,
             };
             if let Some(t) = time {
                 if !t.is_finite() {
@@ -303,16 +257,7 @@ fn execute(cli: Cli) -> Result<()> {
             }
             sample(p, time.unwrap_or(0.0))
         }
-        Command::Render {
-            scene,
-            out,
-            width,
-            height,
-            azimuth,
-            elevation,
-            wireframe,
-            set,
-        } => {
+        Command::Render { scene, out, width, height, azimuth, elevation, wireframe, set } => {
             let mut sc = load(&scene, &set)?;
             if let Some(w) = width {
                 sc.render.size.0 = w.clamp(16, 8192);
@@ -338,9 +283,9 @@ fn execute(cli: Cli) -> Result<()> {
         Command::Bench => bail!(
             "`pdeshape bench` is not available in this version: the papers' solvers it times are not implemented yet"
         ),
-        Command::Serve { .. } => bail!(
-            "`pdeshape serve` is not available in this version: the web editor is not implemented yet"
-        ),
+        Command::Serve { .. } => {
+            bail!("`pdeshape serve` is not available in this version: the web editor is not implemented yet")
+        }
     }
 }
 
@@ -362,17 +307,11 @@ fn sample(p: &pdeshape_io::scene::ScenePatch, t: f64) -> Result<()> {
             continue; // header
         }
         if cols.len() != 2 {
-            bail!(
-                "stdin line {}: expected 2 columns `u,v`, got {}: {l:?}",
-                ln + 1,
-                cols.len()
-            );
+            bail!("stdin line {}: expected 2 columns `u,v`, got {}: {l:?}", ln + 1, cols.len());
         }
         let mut vals = [0.0f64; 2];
         for (k, c) in cols.iter().enumerate() {
-            vals[k] = c
-                .parse()
-                .map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
+            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
             if !vals[k].is_finite() {
                 bail!("stdin line {}: `{c}` is not finite", ln + 1);
             }
@@ -382,25 +321,13 @@ fn sample(p: &pdeshape_io::scene::ScenePatch, t: f64) -> Result<()> {
             bail!("stdin line {}: u = {u} is outside [0, 1]", ln + 1);
         }
         if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
-            bail!(
-                "stdin line {}: v = {v} is outside [{}, {}]",
-                ln + 1,
-                dom.start,
-                dom.end
-            );
+            bail!("stdin line {}: v = {v} is outside [{}, {}]", ln + 1, dom.start, dom.end);
         }
         let x = p.surface.point(u, v);
         if !x.is_finite() {
-            bail!(
-                "stdin line {}: the patch is not finite at (u, v) = ({u}, {v})",
-                ln + 1
-            );
+            bail!("stdin line {}: the patch is not finite at (u, v) = ({u}, {v})", ln + 1);
         }
-        writeln!(
-            out,
-            "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}",
-            x.x, x.y, x.z
-        )?;
+        writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
     }
     out.flush()?;
     Ok(())

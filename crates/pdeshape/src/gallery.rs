@@ -21,10 +21,7 @@ struct Entry {
 }
 
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
 fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
@@ -38,12 +35,7 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         diagnostics: String::new(),
         error: None,
     };
-    let scene = match Scene::parse(
-        text,
-        &format!("examples/{name}.toml"),
-        name,
-        &HashMap::new(),
-    ) {
+    let scene = match Scene::parse(text, &format!("examples/{name}.toml"), name, &HashMap::new()) {
         Ok(s) => s,
         Err(err) => {
             e.error = Some(err.to_string());
@@ -57,12 +49,8 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
     match crate::cli::build_into_dir(&scene, &sub) {
         Ok(files) => {
             for f in files {
-                let rel = format!(
-                    "{name}/{}",
-                    f.file_name()
-                        .map(|s| s.to_string_lossy().into_owned())
-                        .unwrap_or_default()
-                );
+                let rel =
+                    format!("{name}/{}", f.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
                 if rel.ends_with(".png") {
                     e.picture = Some(rel);
                 } else {
@@ -76,9 +64,8 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         }
     }
     let d = model::scene_diagnostics(&scene);
-    let mut t = String::from(
-        "<table><tr><th>patch</th><th>kind</th><th>solver</th><th>max condition error (rel.)</th></tr>",
-    );
+    let mut t =
+        String::from("<table><tr><th>patch</th><th>kind</th><th>solver</th><th>max condition error (rel.)</th></tr>");
     for p in d["patches"].as_array().into_iter().flatten() {
         let _ = write!(
             t,
@@ -97,14 +84,9 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
 /// Builds the gallery; fails (after building the rest) when any example fails.
 pub fn run(dir: &Path, quiet: bool) -> Result<()> {
     std::fs::create_dir_all(dir)?;
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(EXAMPLES.len() as u64)
-    };
+    let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(EXAMPLES.len() as u64) };
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut entries = Vec::new();
     for (name, text) in EXAMPLES {
@@ -157,11 +139,7 @@ pub fn run(dir: &Path, quiet: bool) -> Result<()> {
     }
     if !failed.is_empty() {
         for e in &failed {
-            eprintln!(
-                "example {} failed: {}",
-                e.name,
-                e.error.as_deref().unwrap_or("")
-            );
+            eprintln!("example {} failed: {}", e.name, e.error.as_deref().unwrap_or(""));
         }
         bail!("{} of {} examples failed", failed.len(), entries.len());
     }

@@ -62,12 +62,7 @@ pub struct BSplineCurve {
 
 impl BSplineCurve {
     /// A curve of the given degree through control points `points` over `range`.
-    pub fn new(
-        points: Vec<Vec3>,
-        degree: usize,
-        closed: bool,
-        range: (f64, f64),
-    ) -> Result<Self, BSplineError> {
+    pub fn new(points: Vec<Vec3>, degree: usize, closed: bool, range: (f64, f64)) -> Result<Self, BSplineError> {
         if degree == 0 || degree > 7 {
             return Err(BSplineError::BadDegree(degree));
         }
@@ -81,22 +76,14 @@ impl BSplineCurve {
         let (knots, ctrl) = if closed {
             let min = degree + 1;
             if n < min.max(3) {
-                return Err(BSplineError::TooFewPoints {
-                    kind: "closed B-spline",
-                    min: min.max(3),
-                    got: n,
-                });
+                return Err(BSplineError::TooFewPoints { kind: "closed B-spline", min: min.max(3), got: n });
             }
             let ctrl: Vec<Vec3> = (0..n + degree).map(|i| points[i % n]).collect();
             let knots: Vec<f64> = (0..=n + 2 * degree).map(|i| i as f64).collect();
             (knots, ctrl)
         } else {
             if n < 2 {
-                return Err(BSplineError::TooFewPoints {
-                    kind: "open B-spline",
-                    min: 2,
-                    got: n,
-                });
+                return Err(BSplineError::TooFewPoints { kind: "open B-spline", min: 2, got: n });
             }
             let p = degree.min(n - 1);
             let mut knots = vec![0.0; p + 1];
@@ -105,14 +92,7 @@ impl BSplineCurve {
             (knots, points.clone())
         };
         let degree = if closed { degree } else { degree.min(n - 1) };
-        Ok(BSplineCurve {
-            points,
-            degree,
-            closed,
-            range,
-            knots,
-            ctrl,
-        })
+        Ok(BSplineCurve { points, degree, closed, range, knots, ctrl })
     }
 
     /// The control points as given.
@@ -198,11 +178,7 @@ impl BSplineCurve {
                     d = a[s2][0] * ndu[rk as usize][pk];
                 }
                 let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2 = if (r as isize - 1) <= pk as isize {
-                    k - 1
-                } else {
-                    p - r
-                };
+                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
                 for j in j1..=j2 {
                     let idx = (rk + j as isize) as usize;
                     a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
@@ -241,8 +217,8 @@ impl BSplineCurve {
         let mut d = self.ders_basis(span, x, nd);
         let p = self.degree;
         let mut r = p as f64;
-        for k in 1..d.len() {
-            for x in d[k].iter_mut() {
+        for (k, row) in d.iter_mut().enumerate().skip(1) {
+            for x in row.iter_mut() {
                 *x *= r;
             }
             r *= (p - k) as f64;
@@ -286,11 +262,7 @@ mod tests {
         (0..n)
             .map(|i| {
                 let a = i as f64 * 0.9;
-                Vec3::new(
-                    a.cos() * (1.0 + 0.3 * i as f64),
-                    a.sin(),
-                    (i * i) as f64 * 0.1,
-                )
+                Vec3::new(a.cos() * (1.0 + 0.3 * i as f64), a.sin(), (i * i) as f64 * 0.1)
             })
             .collect()
     }
@@ -344,9 +316,7 @@ mod tests {
     fn bad_input_is_rejected() {
         assert!(BSplineCurve::new(vec![Vec3::ZERO], 3, false, (0.0, 1.0)).is_err());
         assert!(BSplineCurve::new(vec![Vec3::ZERO; 3], 3, true, (0.0, 1.0)).is_err());
-        assert!(
-            BSplineCurve::new(vec![Vec3::new(f64::NAN, 0.0, 0.0); 5], 3, true, (0.0, 1.0)).is_err()
-        );
+        assert!(BSplineCurve::new(vec![Vec3::new(f64::NAN, 0.0, 0.0); 5], 3, true, (0.0, 1.0)).is_err());
         assert!(BSplineCurve::new(vec![Vec3::ZERO; 5], 3, true, (1.0, 1.0)).is_err());
     }
 }

@@ -47,11 +47,7 @@ impl Field for Combination {
         acc
     }
     fn eval(&self, at: &[f64]) -> Vec3 {
-        self.terms
-            .iter()
-            .map(|(w, f)| f.eval(at) * *w)
-            .sum::<Vec3>()
-            + self.constant
+        self.terms.iter().map(|(w, f)| f.eval(at) * *w).sum::<Vec3>() + self.constant
     }
     fn is_constant_in(&self, slot: usize) -> bool {
         self.terms.iter().all(|(_, f)| f.is_constant_in(slot))

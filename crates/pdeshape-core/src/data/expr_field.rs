@@ -35,18 +35,12 @@ impl ExprField {
             comps.push(e.bind(vars, param).map_err(|e| (i, e.with_source(s)))?);
         }
         let comps: [Expr; 3] = comps.try_into().expect("three components");
-        Ok(ExprField {
-            comps,
-            vars: vars.iter().map(|s| s.to_string()).collect(),
-        })
+        Ok(ExprField { comps, vars: vars.iter().map(|s| s.to_string()).collect() })
     }
 
     /// A field from three already bound expressions.
     pub fn from_exprs(comps: [Expr; 3], vars: &[&str]) -> Self {
-        ExprField {
-            comps,
-            vars: vars.iter().map(|s| s.to_string()).collect(),
-        }
+        ExprField { comps, vars: vars.iter().map(|s| s.to_string()).collect() }
     }
 
     /// The component expressions.
@@ -66,19 +60,13 @@ impl Field for ExprField {
     }
 
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
-        let vars: Vec<Jet> = (0..self.vars.len())
-            .map(|i| Jet::variable(shape, i, at[i]))
-            .collect();
+        let vars: Vec<Jet> = (0..self.vars.len()).map(|i| Jet::variable(shape, i, at[i])).collect();
         VecJet(std::array::from_fn(|k| self.comps[k].eval_jet(&vars)))
     }
 
     fn eval(&self, at: &[f64]) -> Vec3 {
         let at = &at[..self.vars.len()];
-        Vec3::new(
-            self.comps[0].eval(at),
-            self.comps[1].eval(at),
-            self.comps[2].eval(at),
-        )
+        Vec3::new(self.comps[0].eval(at), self.comps[1].eval(at), self.comps[2].eval(at))
     }
 
     fn is_constant_in(&self, slot: usize) -> bool {

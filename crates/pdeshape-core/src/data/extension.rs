@@ -27,11 +27,7 @@ impl EvenExtension {
     pub fn map(&self, theta: f64) -> (f64, f64) {
         let th = theta.rem_euclid(2.0 * PI);
         let k = (self.v1 - self.v0) / PI;
-        if th <= PI {
-            (self.v0 + k * th, k)
-        } else {
-            (self.v0 + k * (2.0 * PI - th), -k)
-        }
+        if th <= PI { (self.v0 + k * th, k) } else { (self.v0 + k * (2.0 * PI - th), -k) }
     }
 }
 
@@ -45,11 +41,8 @@ impl Field for EvenExtension {
         a[0] = v;
         let j = self.inner.jet(&a, shape);
         VecJet(std::array::from_fn(|k| {
-            let c: Vec<f64> = shape
-                .multi_indices()
-                .zip(j.0[k].coeffs())
-                .map(|(m, c)| c * dv.powi(m[0] as i32))
-                .collect();
+            let c: Vec<f64> =
+                shape.multi_indices().zip(j.0[k].coeffs()).map(|(m, c)| c * dv.powi(m[0] as i32)).collect();
             Jet::from_coeffs(shape, c)
         }))
     }

@@ -30,13 +30,8 @@ impl FourierSeries {
     /// assert!((s.b[1].y - 1.0).abs() < 1e-14);
     /// ```
     pub fn analyse(f: impl Fn(f64) -> Vec3, modes: usize, samples: usize) -> Self {
-        assert!(
-            samples >= 2 * modes + 1,
-            "{samples} samples cannot resolve {modes} modes"
-        );
-        let pts: Vec<Vec3> = (0..samples)
-            .map(|k| f(2.0 * PI * k as f64 / samples as f64))
-            .collect();
+        assert!(samples > 2 * modes, "{samples} samples cannot resolve {modes} modes");
+        let pts: Vec<Vec3> = (0..samples).map(|k| f(2.0 * PI * k as f64 / samples as f64)).collect();
         Self::from_samples(&pts, modes)
     }
 
@@ -53,8 +48,7 @@ impl FourierSeries {
             for (x, p) in input.iter_mut().zip(pts) {
                 *x = p[comp];
             }
-            fft.process(&mut input, &mut spec)
-                .expect("FFT buffer sizes match");
+            fft.process(&mut input, &mut spec).expect("FFT buffer sizes match");
             for n in 0..=modes.min(s / 2) {
                 // Nyquist term (n = S/2) counts once.
                 let w = if n == 0 || 2 * n == s { 1.0 } else { 2.0 } / s as f64;

@@ -38,18 +38,12 @@ pub struct VecJet(pub [Jet; 3]);
 impl VecJet {
     /// The constant jet with value `p`.
     pub fn constant(shape: JetShape, p: Vec3) -> Self {
-        VecJet([
-            Jet::constant(shape, p.x),
-            Jet::constant(shape, p.y),
-            Jet::constant(shape, p.z),
-        ])
+        VecJet([Jet::constant(shape, p.x), Jet::constant(shape, p.y), Jet::constant(shape, p.z)])
     }
 
     /// A jet from Taylor coefficients given as vectors in storage order.
     pub fn from_vec_coeffs(shape: JetShape, c: &[Vec3]) -> Self {
-        VecJet(std::array::from_fn(|k| {
-            Jet::from_coeffs(shape, c.iter().map(|p| p[k]).collect())
-        }))
+        VecJet(std::array::from_fn(|k| Jet::from_coeffs(shape, c.iter().map(|p| p[k]).collect())))
     }
 
     /// The shape.
@@ -64,11 +58,7 @@ impl VecJet {
 
     /// The partial derivative of multi-index `m` (exact).
     pub fn derivative(&self, m: [usize; MAX_VARS]) -> Vec3 {
-        Vec3::new(
-            self.0[0].derivative(m),
-            self.0[1].derivative(m),
-            self.0[2].derivative(m),
-        )
+        Vec3::new(self.0[0].derivative(m), self.0[1].derivative(m), self.0[2].derivative(m))
     }
 
     /// True when every coefficient is finite.
@@ -159,11 +149,7 @@ where
         self.arity
     }
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
-        let vars: Vec<Jet> = at
-            .iter()
-            .enumerate()
-            .map(|(i, &x)| Jet::variable(shape, i, x))
-            .collect();
+        let vars: Vec<Jet> = at.iter().enumerate().map(|(i, &x)| Jet::variable(shape, i, x)).collect();
         VecJet((self.f)(&vars))
     }
 }

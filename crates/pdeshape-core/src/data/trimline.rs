@@ -28,12 +28,7 @@ impl Trimline {
     /// The `order`-th cross derivative of `surface` (slots `(s, v, t)`) at `s = s0`, times
     /// `scale^order`.
     pub fn new(surface: FieldRef, s0: f64, order: usize, scale: f64) -> Self {
-        Trimline {
-            surface,
-            s0,
-            order,
-            scale,
-        }
+        Trimline { surface, s0, order, scale }
     }
 
     /// The primary surface.
@@ -59,10 +54,7 @@ impl Field for Trimline {
         let sj = self.surface.jet(&[self.s0, at[0], t], big);
         let f = (1..=d).map(|k| k as f64).product::<f64>() * self.scale.powi(d as i32);
         VecJet(std::array::from_fn(|k| {
-            let c: Vec<f64> = shape
-                .multi_indices()
-                .map(|[j, l, _]| sj.0[k].coeff([d, j, l]) * f)
-                .collect();
+            let c: Vec<f64> = shape.multi_indices().map(|[j, l, _]| sj.0[k].coeff([d, j, l]) * f).collect();
             Jet::from_coeffs(shape, c)
         }))
     }

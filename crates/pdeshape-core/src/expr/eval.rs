@@ -36,11 +36,7 @@ pub(super) fn apply_f64(f: Func, a: &[f64]) -> f64 {
 }
 
 fn pow_f64(x: f64, y: f64) -> f64 {
-    if y == y.round() && y.abs() <= 64.0 {
-        x.powi(y as i32)
-    } else {
-        x.powf(y)
-    }
+    if y == y.round() && y.abs() <= 64.0 { x.powi(y as i32) } else { x.powf(y) }
 }
 
 fn apply_jet(f: Func, a: &[Jet]) -> Jet {
@@ -92,10 +88,7 @@ impl Expr {
     /// Evaluates a bound expression on jets: `vars[i]` is the jet of variable slot `i`
     /// (usually [`Jet::variable`]); the result holds every partial derivative exactly.
     pub fn eval_jet(&self, vars: &[Jet]) -> Jet {
-        let shape = vars
-            .first()
-            .map(|j| j.shape())
-            .unwrap_or(crate::jet::JetShape::scalar());
+        let shape = vars.first().map(|j| j.shape()).unwrap_or(crate::jet::JetShape::scalar());
         match &self.node {
             Node::Num(x) => Jet::constant(shape, *x),
             Node::Var(i) => vars[*i].clone(),
@@ -151,15 +144,8 @@ mod tests {
         let j = e.eval_jet(&[Jet::variable(shape, 0, v), Jet::variable(shape, 1, t)]);
         assert!((j.value() - e.eval(&[v, t])).abs() < 1e-14);
         // ∂v⁴∂t: -(b1 a1⁴ sinh(a1 v + a2) + b2 a3⁴ sin(a3 v)) + b3 cos(v)
-        let expect = -(1.5 * 0.5f64.powi(4) * (0.5 * v + 0.1).sinh()
-            + (-0.7) * 16.0 * (2.0 * v).sin())
-            + 0.3 * v.cos();
-        assert!(
-            (j.derivative([4, 1, 0]) - expect).abs() < 1e-12,
-            "{} vs {}",
-            j.derivative([4, 1, 0]),
-            expect
-        );
+        let expect = -(1.5 * 0.5f64.powi(4) * (0.5 * v + 0.1).sinh() + (-0.7) * 16.0 * (2.0 * v).sin()) + 0.3 * v.cos();
+        assert!((j.derivative([4, 1, 0]) - expect).abs() < 1e-12, "{} vs {}", j.derivative([4, 1, 0]), expect);
         // ∂t² = 0
         assert!(j.derivative([3, 2, 0]).abs() < 1e-12);
     }

@@ -23,11 +23,7 @@ impl Term {
         if self.factors.is_empty() {
             "1".into()
         } else {
-            self.factors
-                .iter()
-                .map(|f| f.to_string())
-                .collect::<Vec<_>>()
-                .join("*")
+            self.factors.iter().map(|f| f.to_string()).collect::<Vec<_>>().join("*")
         }
     }
 
@@ -44,14 +40,8 @@ impl Term {
 
 fn raw(e: &Expr) -> Vec<Term> {
     match &e.node {
-        Node::Num(c) => vec![Term {
-            coef: *c,
-            factors: vec![],
-        }],
-        Node::Neg(a) => raw(a)
-            .into_iter()
-            .map(|t| Term { coef: -t.coef, ..t })
-            .collect(),
+        Node::Num(c) => vec![Term { coef: *c, factors: vec![] }],
+        Node::Neg(a) => raw(a).into_iter().map(|t| Term { coef: -t.coef, ..t }).collect(),
         Node::Bin(BinOp::Add, a, b) => {
             let mut r = raw(a);
             r.extend(raw(b));
@@ -65,30 +55,14 @@ fn raw(e: &Expr) -> Vec<Term> {
         Node::Bin(BinOp::Mul, a, b) => product(&raw(a), &raw(b)),
         Node::Bin(BinOp::Div, a, b) if b.as_constant().is_some() => {
             let c = b.as_constant().unwrap_or(1.0);
-            raw(a)
-                .into_iter()
-                .map(|t| Term {
-                    coef: t.coef / c,
-                    ..t
-                })
-                .collect()
+            raw(a).into_iter().map(|t| Term { coef: t.coef / c, ..t }).collect()
         }
-        Node::Bin(BinOp::Pow, a, b) if matches!(b.as_constant(), Some(n) if n >= 0.0 && n == n.round() && n <= 8.0) =>
-        {
+        Node::Bin(BinOp::Pow, a, b) if matches!(b.as_constant(), Some(n) if n >= 0.0 && n == n.round() && n <= 8.0) => {
             let n = b.as_constant().unwrap_or(0.0) as usize;
             let base = raw(a);
-            (0..n).fold(
-                vec![Term {
-                    coef: 1.0,
-                    factors: vec![],
-                }],
-                |acc, _| product(&acc, &base),
-            )
+            (0..n).fold(vec![Term { coef: 1.0, factors: vec![] }], |acc, _| product(&acc, &base))
         }
-        _ => vec![Term {
-            coef: 1.0,
-            factors: vec![e.clone()],
-        }],
+        _ => vec![Term { coef: 1.0, factors: vec![e.clone()] }],
     }
 }
 
@@ -98,10 +72,7 @@ fn product(a: &[Term], b: &[Term]) -> Vec<Term> {
         for y in b {
             let mut f = x.factors.clone();
             f.extend(y.factors.iter().cloned());
-            out.push(Term {
-                coef: x.coef * y.coef,
-                factors: f,
-            });
+            out.push(Term { coef: x.coef * y.coef, factors: f });
         }
     }
     out
@@ -128,10 +99,7 @@ pub fn expand(e: &Expr) -> Vec<Term> {
             out.push((k, t));
         }
     }
-    out.into_iter()
-        .map(|(_, t)| t)
-        .filter(|t| t.coef != 0.0)
-        .collect()
+    out.into_iter().map(|(_, t)| t).filter(|t| t.coef != 0.0).collect()
 }
 
 #[cfg(test)]
@@ -141,16 +109,10 @@ mod tests {
     #[test]
     fn expansion_reproduces_the_expression() {
         let src = "(1 - t)*(1.5*sinh(0.5*v + 0.1) + 2*sin(3*v))^2 / 4 - t*(v - 1)*cos(-v)";
-        let e = Expr::parse(src)
-            .unwrap()
-            .bind(&["v", "t"], &|_| None)
-            .unwrap();
+        let e = Expr::parse(src).unwrap().bind(&["v", "t"], &|_| None).unwrap();
         let terms = expand(&e);
         for &(v, t) in &[(0.3, 0.2), (-1.0, 0.7), (2.5, 0.0)] {
-            let s: f64 = terms
-                .iter()
-                .map(|tm| tm.coef * tm.product().eval(&[v, t]))
-                .sum();
+            let s: f64 = terms.iter().map(|tm| tm.coef * tm.product().eval(&[v, t])).sum();
             assert!((s - e.eval(&[v, t])).abs() < 1e-12);
         }
     }

@@ -103,11 +103,7 @@ impl Func {
 
     /// The function's name.
     pub fn name(self) -> &'static str {
-        Func::ALL
-            .iter()
-            .find(|(_, f)| *f == self)
-            .map(|(n, _)| *n)
-            .unwrap_or("?")
+        Func::ALL.iter().find(|(_, f)| *f == self).map(|(n, _)| *n).unwrap_or("?")
     }
 
     /// Number of arguments.
@@ -168,20 +164,13 @@ impl Expr {
 
     /// A number.
     pub fn num(x: f64) -> Expr {
-        Expr {
-            node: Node::Num(x),
-            span: Span { start: 0, end: 0 },
-        }
+        Expr { node: Node::Num(x), span: Span { start: 0, end: 0 } }
     }
 
     /// Resolves identifiers: names in `vars` become variable slots (by position), other
     /// names are looked up with `param` (then the constants `pi`, `e`); anything else is an
     /// error naming the identifier and its column. Constant sub-expressions are folded.
-    pub fn bind(
-        &self,
-        vars: &[&str],
-        param: &dyn Fn(&str) -> Option<f64>,
-    ) -> Result<Expr, ExprError> {
+    pub fn bind(&self, vars: &[&str], param: &dyn Fn(&str) -> Option<f64>) -> Result<Expr, ExprError> {
         parse::bind(self, vars, param)
     }
 
@@ -189,10 +178,10 @@ impl Expr {
     pub fn identifiers(&self) -> Vec<String> {
         let mut out = Vec::new();
         self.visit(&mut |e| {
-            if let Node::Ident(n) = &e.node {
-                if !out.contains(n) {
-                    out.push(n.clone());
-                }
+            if let Node::Ident(n) = &e.node
+                && !out.contains(n)
+            {
+                out.push(n.clone());
             }
         });
         out

@@ -16,11 +16,7 @@ pub struct ExprError {
 
 impl ExprError {
     fn new(src: &str, span: Span, message: impl Into<String>) -> Self {
-        ExprError {
-            message: message.into(),
-            source_text: src.to_string(),
-            span,
-        }
+        ExprError { message: message.into(), source_text: src.to_string(), span }
     }
 
     /// Attaches the source text (name binding works on the tree, which does not keep it).
@@ -29,20 +25,22 @@ impl ExprError {
         self
     }
 
+    /// A copy with the source text attached.
+    pub fn with_source_ref(&self, src: &str) -> Self {
+        self.clone().with_source(src)
+    }
+
     /// The 1-based column (in characters) the error points at.
     pub fn column(&self) -> usize {
-        self.source_text[..self.span.start.min(self.source_text.len())]
-            .chars()
-            .count()
-            + 1
+        self.source_text[..self.span.start.min(self.source_text.len())].chars().count() + 1
     }
 }
 
 impl fmt::Display for ExprError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let col = self.column();
-        let width = self.source_text[self.span.start.min(self.source_text.len())
-            ..self.span.end.min(self.source_text.len())]
+        let width = self.source_text
+            [self.span.start.min(self.source_text.len())..self.span.end.min(self.source_text.len())]
             .chars()
             .count()
             .max(1);
@@ -72,18 +70,14 @@ struct Lexer<'a> {
 }
 
 fn lex(src: &str) -> Result<Vec<(Tok, Span)>, ExprError> {
-    let mut lx = Lexer {
-        src,
-        toks: Vec::new(),
-    };
+    let mut lx = Lexer { src, toks: Vec::new() };
     let b = src.as_bytes();
     let mut i = 0;
     while i < b.len() {
         let c = b[i];
         if c.is_ascii_whitespace() {
             i += 1;
-        } else if c.is_ascii_digit() || (c == b'.' && i + 1 < b.len() && b[i + 1].is_ascii_digit())
-        {
+        } else if c.is_ascii_digit() || (c == b'.' && i + 1 < b.len() && b[i + 1].is_ascii_digit()) {
             let start = i;
             while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.') {
                 i += 1;
@@ -102,58 +96,32 @@ fn lex(src: &str) -> Result<Vec<(Tok, Span)>, ExprError> {
             }
             let text = &src[start..i];
             let span = Span { start, end: i };
-            let x: f64 = text
-                .parse()
-                .map_err(|_| ExprError::new(src, span, format!("malformed number `{text}`")))?;
+            let x: f64 = text.parse().map_err(|_| ExprError::new(src, span, format!("malformed number `{text}`")))?;
             lx.toks.push((Tok::Num(x), span));
         } else if c.is_ascii_alphabetic() || c == b'_' {
             let start = i;
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
                 i += 1;
             }
-            lx.toks.push((
-                Tok::Ident(src[start..i].to_string()),
-                Span { start, end: i },
-            ));
+            lx.toks.push((Tok::Ident(src[start..i].to_string()), Span { start, end: i }));
         } else if b"+-*/^(),".contains(&c) {
             if c == b'*' && i + 1 < b.len() && b[i + 1] == b'*' {
-                lx.toks.push((
-                    Tok::Op('^'),
-                    Span {
-                        start: i,
-                        end: i + 2,
-                    },
-                ));
+                lx.toks.push((Tok::Op('^'), Span { start: i, end: i + 2 }));
                 i += 2;
             } else {
-                lx.toks.push((
-                    Tok::Op(c as char),
-                    Span {
-                        start: i,
-                        end: i + 1,
-                    },
-                ));
+                lx.toks.push((Tok::Op(c as char), Span { start: i, end: i + 1 }));
                 i += 1;
             }
         } else {
             let ch = src[i..].chars().next().unwrap_or('?');
             return Err(ExprError::new(
                 src,
-                Span {
-                    start: i,
-                    end: i + ch.len_utf8(),
-                },
+                Span { start: i, end: i + ch.len_utf8() },
                 format!("unexpected character `{ch}`"),
             ));
         }
     }
-    lx.toks.push((
-        Tok::End,
-        Span {
-            start: lx.src.len(),
-            end: lx.src.len(),
-        },
-    ));
+    lx.toks.push((Tok::End, Span { start: lx.src.len(), end: lx.src.len() }));
     Ok(lx.toks)
 }
 
@@ -231,14 +199,8 @@ impl<'a> Parser<'a> {
             Tok::Op('-') => {
                 let (_, s) = self.next();
                 let a = self.unary()?;
-                let span = Span {
-                    start: s.start,
-                    end: a.span.end,
-                };
-                Ok(Expr {
-                    node: Node::Neg(Box::new(a)),
-                    span,
-                })
+                let span = Span { start: s.start, end: a.span.end };
+                Ok(Expr { node: Node::Neg(Box::new(a)), span })
             }
             Tok::Op('+') => {
                 self.next();
@@ -263,10 +225,7 @@ impl<'a> Parser<'a> {
     fn primary(&mut self) -> Result<Expr, ExprError> {
         let (tok, span) = self.next();
         match tok {
-            Tok::Num(x) => Ok(Expr {
-                node: Node::Num(x),
-                span,
-            }),
+            Tok::Num(x) => Ok(Expr { node: Node::Num(x), span }),
             Tok::Ident(name) => {
                 if let Tok::Op('(') = self.peek() {
                     let func = Func::from_name(&name).ok_or_else(|| {
@@ -275,11 +234,7 @@ impl<'a> Parser<'a> {
                             span,
                             format!(
                                 "unknown function `{name}` (known: {})",
-                                Func::ALL
-                                    .iter()
-                                    .map(|(n, _)| *n)
-                                    .collect::<Vec<_>>()
-                                    .join(" ")
+                                Func::ALL.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(" ")
                             ),
                         )
                     })?;
@@ -303,10 +258,7 @@ impl<'a> Parser<'a> {
                         }
                     }
                     let (_, close) = self.next();
-                    let full = Span {
-                        start: span.start,
-                        end: close.end,
-                    };
+                    let full = Span { start: span.start, end: close.end };
                     if args.len() != func.arity() {
                         return Err(ExprError::new(
                             self.src,
@@ -319,15 +271,9 @@ impl<'a> Parser<'a> {
                             ),
                         ));
                     }
-                    Ok(Expr {
-                        node: Node::Call(func, args),
-                        span: full,
-                    })
+                    Ok(Expr { node: Node::Call(func, args), span: full })
                 } else {
-                    Ok(Expr {
-                        node: Node::Ident(name),
-                        span,
-                    })
+                    Ok(Expr { node: Node::Ident(name), span })
                 }
             }
             Tok::Op('(') => {
@@ -335,13 +281,7 @@ impl<'a> Parser<'a> {
                 match self.peek() {
                     Tok::Op(')') => {
                         let (_, close) = self.next();
-                        Ok(Expr {
-                            node: inner.node,
-                            span: Span {
-                                start: span.start,
-                                end: close.end,
-                            },
-                        })
+                        Ok(Expr { node: inner.node, span: Span { start: span.start, end: close.end } })
                     }
                     t => Err(self.err(format!("expected `)`, found {}", Self::describe(t)))),
                 }
@@ -349,48 +289,27 @@ impl<'a> Parser<'a> {
             t => Err(ExprError::new(
                 self.src,
                 span,
-                format!(
-                    "expected a number, a name or `(`, found {}",
-                    Self::describe(&t)
-                ),
+                format!("expected a number, a name or `(`, found {}", Self::describe(&t)),
             )),
         }
     }
 }
 
 fn bin(op: BinOp, a: Expr, b: Expr) -> Expr {
-    let span = Span {
-        start: a.span.start,
-        end: b.span.end,
-    };
-    Expr {
-        node: Node::Bin(op, Box::new(a), Box::new(b)),
-        span,
-    }
+    let span = Span { start: a.span.start, end: b.span.end };
+    Expr { node: Node::Bin(op, Box::new(a), Box::new(b)), span }
 }
 
 pub(super) fn parse(src: &str) -> Result<Expr, ExprError> {
     if src.trim().is_empty() {
-        return Err(ExprError::new(
-            src,
-            Span { start: 0, end: 0 },
-            "empty expression",
-        ));
+        return Err(ExprError::new(src, Span { start: 0, end: 0 }, "empty expression"));
     }
     let toks = lex(src)?;
-    let mut p = Parser {
-        src,
-        toks,
-        pos: 0,
-        depth: 0,
-    };
+    let mut p = Parser { src, toks, pos: 0, depth: 0 };
     let e = p.expr()?;
     if !matches!(p.peek(), Tok::End) {
         let t = p.peek().clone();
-        return Err(p.err(format!(
-            "unexpected {} after a complete expression",
-            Parser::describe(&t)
-        )));
+        return Err(p.err(format!("unexpected {} after a complete expression", Parser::describe(&t))));
     }
     Ok(e)
 }
@@ -418,18 +337,10 @@ fn fold(e: &Expr) -> Option<f64> {
     }
 }
 
-pub(super) fn bind(
-    e: &Expr,
-    vars: &[&str],
-    param: &dyn Fn(&str) -> Option<f64>,
-) -> Result<Expr, ExprError> {
+pub(super) fn bind(e: &Expr, vars: &[&str], param: &dyn Fn(&str) -> Option<f64>) -> Result<Expr, ExprError> {
     // The source text is not kept in the tree; errors rebuild it from spans when the caller
     // re-parses. Here we report the name and rely on the span for the column.
-    fn go(
-        e: &Expr,
-        vars: &[&str],
-        param: &dyn Fn(&str) -> Option<f64>,
-    ) -> Result<Expr, (Span, String)> {
+    fn go(e: &Expr, vars: &[&str], param: &dyn Fn(&str) -> Option<f64>) -> Result<Expr, (Span, String)> {
         let node = match &e.node {
             Node::Ident(name) => {
                 if let Some(i) = vars.iter().position(|v| v == name) {
@@ -446,40 +357,21 @@ pub(super) fn bind(
                     } else {
                         format!("variables here: {}", vars.join(", "))
                     };
-                    return Err((
-                        e.span,
-                        format!("unknown name `{name}` ({vs}; or a parameter, pi, e)"),
-                    ));
+                    return Err((e.span, format!("unknown name `{name}` ({vs}; or a parameter, pi, e)")));
                 }
             }
             Node::Neg(a) => Node::Neg(Box::new(go(a, vars, param)?)),
-            Node::Bin(op, a, b) => Node::Bin(
-                *op,
-                Box::new(go(a, vars, param)?),
-                Box::new(go(b, vars, param)?),
-            ),
-            Node::Call(f, args) => Node::Call(
-                *f,
-                args.iter()
-                    .map(|a| go(a, vars, param))
-                    .collect::<Result<_, _>>()?,
-            ),
+            Node::Bin(op, a, b) => Node::Bin(*op, Box::new(go(a, vars, param)?), Box::new(go(b, vars, param)?)),
+            Node::Call(f, args) => Node::Call(*f, args.iter().map(|a| go(a, vars, param)).collect::<Result<_, _>>()?),
             n => n.clone(),
         };
         let out = Expr { node, span: e.span };
         Ok(match fold(&out) {
-            Some(x) if !matches!(out.node, Node::Num(_)) => Expr {
-                node: Node::Num(x),
-                span: e.span,
-            },
+            Some(x) if !matches!(out.node, Node::Num(_)) => Expr { node: Node::Num(x), span: e.span },
             _ => out,
         })
     }
-    go(e, vars, param).map_err(|(span, msg)| ExprError {
-        message: msg,
-        source_text: String::new(),
-        span,
-    })
+    go(e, vars, param).map_err(|(span, msg)| ExprError { message: msg, source_text: String::new(), span })
 }
 
 #[cfg(test)]
@@ -487,11 +379,7 @@ mod tests {
     use super::*;
 
     fn p(s: &str) -> f64 {
-        Expr::parse(s)
-            .unwrap()
-            .bind(&["v"], &|_| None)
-            .unwrap()
-            .eval(&[0.5])
+        Expr::parse(s).unwrap().bind(&["v"], &|_| None).unwrap().eval(&[0.5])
     }
 
     #[test]
@@ -528,16 +416,8 @@ mod tests {
         assert!(Expr::parse("").is_err());
         assert!(Expr::parse("(((").is_err());
         let deep = "(".repeat(5000) + "1" + &")".repeat(5000);
-        assert!(
-            Expr::parse(&deep)
-                .unwrap_err()
-                .message
-                .contains("nested deeper")
-        );
-        let e = Expr::parse("v + q")
-            .unwrap()
-            .bind(&["v"], &|_| None)
-            .unwrap_err();
+        assert!(Expr::parse(&deep).unwrap_err().message.contains("nested deeper"));
+        let e = Expr::parse("v + q").unwrap().bind(&["v"], &|_| None).unwrap_err();
         assert!(e.message.contains("unknown name `q`"));
         assert_eq!(e.span.start, 4);
     }

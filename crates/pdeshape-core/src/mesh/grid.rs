@@ -19,23 +19,15 @@ pub struct GridOptions {
 impl GridOptions {
     /// `nu × nv` vertices over `u ∈ [0, 1]`.
     pub fn new(nu: usize, nv: usize) -> Self {
-        GridOptions {
-            nu,
-            nv,
-            u_range: (0.0, 1.0),
-        }
+        GridOptions { nu, nv, u_range: (0.0, 1.0) }
     }
 }
 
 /// The `u` and `v` parameter values of the grid vertices.
 pub fn grid_params(s: &dyn Surface, o: &GridOptions) -> (Vec<f64>, Vec<f64>) {
     let d = s.v_domain();
-    let us = (0..o.nu)
-        .map(|i| o.u_range.0 + (o.u_range.1 - o.u_range.0) * i as f64 / (o.nu - 1) as f64)
-        .collect();
-    let vs = (0..o.nv)
-        .map(|j| d.at(j as f64 / (o.nv - 1) as f64))
-        .collect();
+    let us = (0..o.nu).map(|i| o.u_range.0 + (o.u_range.1 - o.u_range.0) * i as f64 / (o.nu - 1) as f64).collect();
+    let vs = (0..o.nv).map(|j| d.at(j as f64 / (o.nv - 1) as f64)).collect();
     (us, vs)
 }
 
@@ -49,10 +41,7 @@ pub fn grid_params(s: &dyn Surface, o: &GridOptions) -> (Vec<f64>, Vec<f64>) {
 ///
 /// Fails (naming the parameters) when the patch evaluates to a non-finite point.
 pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
-    assert!(
-        o.nu >= 2 && o.nv >= 2,
-        "a grid mesh needs at least 2 × 2 vertices"
-    );
+    assert!(o.nu >= 2 && o.nv >= 2, "a grid mesh needs at least 2 × 2 vertices");
     let (us, vs) = grid_params(s, o);
     let rows: Vec<Vec<[Vec3; 4]>> = us
         .par_iter()
@@ -69,11 +58,7 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     let mut positions = Vec::with_capacity(n);
     let mut normals = Vec::with_capacity(n);
     let mut uvs = Vec::with_capacity(n);
-    let mut scales: Vec<f64> = rows
-        .iter()
-        .flatten()
-        .map(|d| d[1].norm() * d[2].norm())
-        .collect();
+    let mut scales: Vec<f64> = rows.iter().flatten().map(|d| d[1].norm() * d[2].norm()).collect();
     scales.sort_by(f64::total_cmp);
     let reference = scales[scales.len() / 2].max(f64::MIN_POSITIVE);
     let dom = s.v_domain();
@@ -82,28 +67,13 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
         for (j, d) in row.iter().enumerate() {
             let [p, pu, pv, puv] = *d;
             if !p.is_finite() {
-                return Err(format!(
-                    "the patch is not finite at (u, v) = ({}, {})",
-                    us[i], vs[j]
-                ));
+                return Err(format!("the patch is not finite at (u, v) = ({}, {})", us[i], vs[j]));
             }
             let mut nrm = pu.cross(pv);
             if nrm.norm() <= 1e-9 * reference {
-                let side_u = if us[i] < 0.5 * (o.u_range.0 + o.u_range.1) {
-                    1.0
-                } else {
-                    -1.0
-                };
-                let side_v = if vs[j] < 0.5 * (dom.start + dom.end) {
-                    1.0
-                } else {
-                    -1.0
-                };
-                nrm = if pv.norm() <= pu.norm() {
-                    pu.cross(puv) * side_u
-                } else {
-                    puv.cross(pv) * side_v
-                };
+                let side_u = if us[i] < 0.5 * (o.u_range.0 + o.u_range.1) { 1.0 } else { -1.0 };
+                let side_v = if vs[j] < 0.5 * (dom.start + dom.end) { 1.0 } else { -1.0 };
+                nrm = if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v };
             }
             match nrm.normalized() {
                 Some(n) => normals.push(n),
@@ -119,16 +89,7 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     for &k in &missing {
         let (i, j) = (k / o.nv, k % o.nv);
         let mut acc = Vec3::ZERO;
-        for (di, dj) in [
-            (-1i64, 0i64),
-            (1, 0),
-            (0, -1),
-            (0, 1),
-            (-1, -1),
-            (1, 1),
-            (-1, 1),
-            (1, -1),
-        ] {
+        for (di, dj) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1), (-1, -1), (1, 1), (-1, 1), (1, -1)] {
             let (a, b) = (i as i64 + di, j as i64 + dj);
             if a >= 0 && b >= 0 && (a as usize) < o.nu && (b as usize) < o.nv {
                 acc += normals[a as usize * o.nv + b as usize];
@@ -145,34 +106,16 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
             quads.push([a, b, b + 1, a + 1]);
         }
     }
-    Ok(Mesh {
-        positions,
-        normals,
-        uvs,
-        quads,
-        grid: Some((o.nu, o.nv)),
-        ..Default::default()
-    })
+    Ok(Mesh { positions, normals, uvs, quads, grid: Some((o.nu, o.nv)), ..Default::default() })
 }
 
 impl Mesh {
     /// Adds a per-vertex field computed from `(u, v)` of a structured grid mesh.
-    pub fn add_grid_field(
-        &mut self,
-        name: &str,
-        s: &dyn Surface,
-        f: impl Fn(&dyn Surface, f64, f64) -> f64 + Sync,
-    ) {
+    pub fn add_grid_field(&mut self, name: &str, s: &dyn Surface, f: impl Fn(&dyn Surface, f64, f64) -> f64 + Sync) {
         let Some((nu, nv)) = self.grid else { return };
         let (us, vs) = grid_params(s, &GridOptions::new(nu, nv));
-        let values: Vec<f64> = (0..nu * nv)
-            .into_par_iter()
-            .map(|k| f(s, us[k / nv], vs[k % nv]))
-            .collect();
-        self.fields.push(ScalarField {
-            name: name.into(),
-            values,
-        });
+        let values: Vec<f64> = (0..nu * nv).into_par_iter().map(|k| f(s, us[k / nv], vs[k % nv])).collect();
+        self.fields.push(ScalarField { name: name.into(), values });
     }
 }
 
@@ -213,12 +156,7 @@ mod tests {
             assert!((r.dot(*n).abs() - 1.0).abs() < 1e-9, "{p:?} {n:?}");
         }
         let s0 = m.positions[20].dot(m.normals[20]).signum();
-        assert!(
-            m.positions
-                .iter()
-                .zip(&m.normals)
-                .all(|(p, n)| p.dot(*n).signum() == s0)
-        );
+        assert!(m.positions.iter().zip(&m.normals).all(|(p, n)| p.dot(*n).signum() == s0));
         assert_eq!(m.quads.len(), 8 * 12);
     }
 }

@@ -85,23 +85,14 @@ impl Mesh {
     /// Checks that every coordinate, normal and field value is finite.
     pub fn check_finite(&self) -> Result<(), String> {
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "mesh `{}`: vertex {i} has a non-finite position",
-                self.name
-            ));
+            return Err(format!("mesh `{}`: vertex {i} has a non-finite position", self.name));
         }
         if let Some(i) = self.normals.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "mesh `{}`: vertex {i} has a non-finite normal",
-                self.name
-            ));
+            return Err(format!("mesh `{}`: vertex {i} has a non-finite normal", self.name));
         }
         for f in &self.fields {
             if let Some(i) = f.values.iter().position(|x| !x.is_finite()) {
-                return Err(format!(
-                    "mesh `{}`: field `{}` is not finite at vertex {i}",
-                    self.name, f.name
-                ));
+                return Err(format!("mesh `{}`: field `{}` is not finite at vertex {i}", self.name, f.name));
             }
         }
         Ok(())

@@ -49,10 +49,7 @@ pub struct HermiteBasis {
 impl HermiteBasis {
     /// The basis with `r` conditions per end (`1 ≤ r ≤ 6`).
     pub fn new(r: usize) -> Self {
-        assert!(
-            (1..=6).contains(&r),
-            "Hermite basis with {r} conditions per end"
-        );
+        assert!((1..=6).contains(&r), "Hermite basis with {r} conditions per end");
         let n = 2 * r;
         // Row (e, k): the k-th derivative at u = e of each monomial uʲ.
         let a = Mat::from_fn(n, n, |row, j| {
@@ -61,9 +58,7 @@ impl HermiteBasis {
         });
         let solver = SquareSolver::new(&a, 1e12).expect("Hermite interpolation is unisolvent");
         let x = solver.solve(&Mat::<f64>::identity(n, n));
-        let polys = (0..n)
-            .map(|col| Poly((0..n).map(|i| x[(i, col)]).collect()))
-            .collect();
+        let polys = (0..n).map(|col| Poly((0..n).map(|i| x[(i, col)]).collect())).collect();
         HermiteBasis { r, polys }
     }
 
@@ -82,9 +77,7 @@ impl HermiteBasis {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum HermitePatchError {
     /// The conditions are not `∂⁰ … ∂^{r−1}` at both `u = 0` and `u = 1`.
-    #[error(
-        "a Hermite patch needs the same derivative orders 0 … r−1 (r ≤ 3) at u = 0 and at u = 1; got {0}"
-    )]
+    #[error("a Hermite patch needs the same derivative orders 0 … r−1 (r ≤ 3) at u = 0 and at u = 1; got {0}")]
     BadConditions(String),
 }
 
@@ -106,13 +99,7 @@ pub struct HermitePatch {
 impl HermitePatch {
     /// Builds the patch from conditions at `u = 0` and `u = 1`.
     pub fn new(conds: &[Condition], domain: VDomain) -> Result<Self, HermitePatchError> {
-        let describe = || {
-            conds
-                .iter()
-                .map(|c| format!("∂^{} at u = {}", c.order, c.u))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let describe = || conds.iter().map(|c| format!("∂^{} at u = {}", c.order, c.u)).collect::<Vec<_>>().join(", ");
         let mut ends: [Vec<Option<FieldRef>>; 2] = [vec![None; 3], vec![None; 3]];
         for c in conds {
             let e = if c.u == 0.0 {
@@ -128,28 +115,19 @@ impl HermitePatch {
             ends[e][c.order] = Some(c.data.clone());
         }
         let r = conds.len() / 2;
-        if r == 0 || conds.len() % 2 != 0 {
+        if r == 0 || !conds.len().is_multiple_of(2) {
             return Err(HermitePatchError::BadConditions(describe()));
         }
-        let take =
-            |e: usize| -> Option<Vec<FieldRef>> { (0..r).map(|d| ends[e][d].clone()).collect() };
+        let take = |e: usize| -> Option<Vec<FieldRef>> { (0..r).map(|d| ends[e][d].clone()).collect() };
         let (Some(e0), Some(e1)) = (take(0), take(1)) else {
             return Err(HermitePatchError::BadConditions(describe()));
         };
-        Ok(HermitePatch {
-            basis: HermiteBasis::new(r),
-            ends: [e0, e1],
-            domain,
-            time: 0.0,
-        })
+        Ok(HermitePatch { basis: HermiteBasis::new(r), ends: [e0, e1], domain, time: 0.0 })
     }
 
     /// The same patch with its data evaluated at time `t`.
     pub fn at_time(&self, t: f64) -> Self {
-        HermitePatch {
-            time: t,
-            ..self.clone()
-        }
+        HermitePatch { time: t, ..self.clone() }
     }
 }
 
@@ -194,10 +172,7 @@ mod tests {
                         for k in 0..r {
                             let want = if e == e2 && d == k { 1.0 } else { 0.0 };
                             let got = h.basis(e, d).derivative(e2 as f64, k);
-                            assert!(
-                                (got - want).abs() < 1e-12,
-                                "r {r} H_{e},{d}^({k})({e2}) = {got}"
-                            );
+                            assert!((got - want).abs() < 1e-12, "r {r} H_{e},{d}^({k})({e2}) = {got}");
                         }
                     }
                 }

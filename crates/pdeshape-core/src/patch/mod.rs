@@ -27,19 +27,11 @@ pub struct VDomain {
 
 impl VDomain {
     /// The closed-patch domain `[0, 2π)`.
-    pub const PERIODIC: VDomain = VDomain {
-        start: 0.0,
-        end: 2.0 * PI,
-        periodic: true,
-    };
+    pub const PERIODIC: VDomain = VDomain { start: 0.0, end: 2.0 * PI, periodic: true };
 
     /// An open domain `[start, end]`.
     pub fn open(start: f64, end: f64) -> Self {
-        VDomain {
-            start,
-            end,
-            periodic: false,
-        }
+        VDomain { start, end, periodic: false }
     }
 
     /// The point `start + f (end − start)`.
@@ -93,12 +85,7 @@ pub struct ConditionReport {
 
 /// Checks every condition at `samples` equispaced `v` (plus pseudo-random jitter so no
 /// grid is favoured) at time `t`.
-pub fn check_conditions(
-    s: &dyn Surface,
-    conds: &[Condition],
-    t: f64,
-    samples: usize,
-) -> ConditionReport {
+pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: usize) -> ConditionReport {
     let dom = s.v_domain();
     let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut hi = -lo;
@@ -124,9 +111,5 @@ pub fn check_conditions(
         }
     }
     let size = (hi - lo).norm().max(f64::MIN_POSITIVE);
-    ConditionReport {
-        max_abs,
-        max_rel: max_abs / size,
-        size,
-    }
+    ConditionReport { max_abs, max_rel: max_abs / size, size }
 }

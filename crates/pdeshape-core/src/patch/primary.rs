@@ -18,12 +18,7 @@ pub struct PrimarySurface {
 impl PrimarySurface {
     /// The part `s ∈ [s₀, s₁]` of `surface` (slots `(s, v, t)`) over `domain` at time `t`.
     pub fn new(surface: FieldRef, s_range: (f64, f64), domain: VDomain, time: f64) -> Self {
-        PrimarySurface {
-            surface,
-            s_range,
-            domain,
-            time,
-        }
+        PrimarySurface { surface, s_range, domain, time }
     }
 }
 

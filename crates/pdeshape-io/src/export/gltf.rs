@@ -13,19 +13,13 @@ struct Bin {
 
 impl Bin {
     fn align(&mut self) {
-        while self.data.len() % 4 != 0 {
+        while !self.data.len().is_multiple_of(4) {
             self.data.push(0);
         }
     }
 
     /// Appends f32 tuples and returns the accessor index.
-    fn floats(
-        &mut self,
-        items: &[Vec<f32>],
-        kind: &str,
-        with_bounds: bool,
-        target: Option<u32>,
-    ) -> usize {
+    fn floats(&mut self, items: &[Vec<f32>], kind: &str, with_bounds: bool, target: Option<u32>) -> usize {
         self.align();
         let offset = self.data.len();
         let width = items.first().map(|v| v.len()).unwrap_or(1);
@@ -38,8 +32,7 @@ impl Bin {
                 hi[k] = hi[k].max(x);
             }
         }
-        let mut view =
-            json!({"buffer": 0, "byteOffset": offset, "byteLength": self.data.len() - offset});
+        let mut view = json!({"buffer": 0, "byteOffset": offset, "byteLength": self.data.len() - offset});
         if let Some(t) = target {
             view["target"] = json!(t);
         }
@@ -62,16 +55,17 @@ impl Bin {
         for i in idx {
             self.data.extend_from_slice(&i.to_le_bytes());
         }
-        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": self.data.len() - offset, "target": 34963}));
-        self.accessors.push(json!({"bufferView": self.views.len() - 1, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": self.data.len() - offset, "target": 34963}));
+        self.accessors.push(
+            json!({"bufferView": self.views.len() - 1, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}),
+        );
         self.accessors.len() - 1
     }
 }
 
 fn v3(p: &[Vec3]) -> Vec<Vec<f32>> {
-    p.iter()
-        .map(|q| vec![q.x as f32, q.y as f32, q.z as f32])
-        .collect()
+    p.iter().map(|q| vec![q.x as f32, q.y as f32, q.z as f32]).collect()
 }
 
 /// Writes meshes as a glTF 2.0 binary: one node and mesh per patch (named), positions,
@@ -80,46 +74,24 @@ fn v3(p: &[Vec3]) -> Vec<Vec<f32>> {
 /// animation that steps the weights through the frames (linear interpolation between
 /// neighbouring frames).
 pub fn write_glb(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
-    let mut bin = Bin {
-        data: Vec::new(),
-        views: Vec::new(),
-        accessors: Vec::new(),
-    };
+    let mut bin = Bin { data: Vec::new(), views: Vec::new(), accessors: Vec::new() };
     let mut gl_meshes = Vec::new();
     let mut nodes = Vec::new();
     let mut materials = Vec::new();
     let mut animations = Vec::new();
     for (k, m) in meshes.iter().enumerate() {
         let mut attrs = serde_json::Map::new();
-        attrs.insert(
-            "POSITION".into(),
-            json!(bin.floats(&v3(&m.positions), "VEC3", true, Some(34962))),
-        );
+        attrs.insert("POSITION".into(), json!(bin.floats(&v3(&m.positions), "VEC3", true, Some(34962))));
         if !m.normals.is_empty() {
-            attrs.insert(
-                "NORMAL".into(),
-                json!(bin.floats(&v3(&m.normals), "VEC3", false, Some(34962))),
-            );
+            attrs.insert("NORMAL".into(), json!(bin.floats(&v3(&m.normals), "VEC3", false, Some(34962))));
         }
         if !m.uvs.is_empty() {
-            let uv: Vec<Vec<f32>> = m
-                .uvs
-                .iter()
-                .map(|t| vec![t[0] as f32, t[1] as f32])
-                .collect();
-            attrs.insert(
-                "TEXCOORD_0".into(),
-                json!(bin.floats(&uv, "VEC2", false, Some(34962))),
-            );
+            let uv: Vec<Vec<f32>> = m.uvs.iter().map(|t| vec![t[0] as f32, t[1] as f32]).collect();
+            attrs.insert("TEXCOORD_0".into(), json!(bin.floats(&uv, "VEC2", false, Some(34962))));
         }
         for f in &m.fields {
             let vals: Vec<Vec<f32>> = f.values.iter().map(|x| vec![*x as f32]).collect();
-            let name = format!(
-                "_{}",
-                f.name
-                    .to_ascii_uppercase()
-                    .replace(|c: char| !c.is_ascii_alphanumeric(), "_")
-            );
+            let name = format!("_{}", f.name.to_ascii_uppercase().replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
             attrs.insert(name, json!(bin.floats(&vals, "SCALAR", false, Some(34962))));
         }
         let tris: Vec<u32> = m.all_triangles().into_iter().flatten().collect();
@@ -137,16 +109,10 @@ pub fn write_glb(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
             for (f, pos) in anim.positions.iter().enumerate() {
                 let dp: Vec<Vec3> = pos.iter().zip(&m.positions).map(|(a, b)| *a - *b).collect();
                 let mut t = serde_json::Map::new();
-                t.insert(
-                    "POSITION".into(),
-                    json!(bin.floats(&v3(&dp), "VEC3", true, Some(34962))),
-                );
+                t.insert("POSITION".into(), json!(bin.floats(&v3(&dp), "VEC3", true, Some(34962))));
                 if let (Some(nf), false) = (anim.normals.get(f), m.normals.is_empty()) {
                     let dn: Vec<Vec3> = nf.iter().zip(&m.normals).map(|(a, b)| *a - *b).collect();
-                    t.insert(
-                        "NORMAL".into(),
-                        json!(bin.floats(&v3(&dn), "VEC3", false, Some(34962))),
-                    );
+                    t.insert("NORMAL".into(), json!(bin.floats(&v3(&dn), "VEC3", false, Some(34962))));
                 }
                 targets.push(Value::Object(t));
             }
@@ -158,9 +124,8 @@ pub fn write_glb(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
             mesh["extras"] = json!({"targetNames": anim.times.iter().map(|t| format!("t={t}")).collect::<Vec<_>>()});
             let times: Vec<Vec<f32>> = anim.times.iter().map(|t| vec![*t as f32]).collect();
             let input = bin.floats(&times, "SCALAR", true, None);
-            let weights: Vec<Vec<f32>> = (0..n)
-                .flat_map(|f| (0..n).map(move |j| vec![if j == f { 1.0 } else { 0.0 }]))
-                .collect();
+            let weights: Vec<Vec<f32>> =
+                (0..n).flat_map(|f| (0..n).map(move |j| vec![if j == f { 1.0 } else { 0.0 }])).collect();
             let output = bin.floats(&weights, "SCALAR", false, None);
             animations.push(json!({
                 "name": format!("{}-animation", m.name),
@@ -188,7 +153,7 @@ pub fn write_glb(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
         doc["animations"] = json!(animations);
     }
     let mut text = serde_json::to_vec(&doc).map_err(io::Error::other)?;
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.data.len();

@@ -22,18 +22,20 @@ use std::path::Path;
 
 /// Writes `path` atomically: `f` writes into a temporary file in the same directory,
 /// which is renamed to `path` only when `f` succeeds.
-pub fn write_atomic(
-    path: &Path,
-    f: impl FnOnce(&mut dyn Write) -> io::Result<()>,
-) -> io::Result<()> {
+pub fn write_atomic(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(".pdeshape-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".pdeshape-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // Outputs are ordinary files (the temporary file would otherwise keep mode 0600).
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let tmp = builder.tempfile_in(dir)?;
     {
         let mut w = BufWriter::new(tmp.as_file());
         f(&mut w)?;
@@ -88,8 +90,7 @@ impl Format {
 /// values: no NaN ever reaches a file.
 pub fn write_meshes(path: &Path, format: Format, meshes: &[&Mesh]) -> io::Result<()> {
     for m in meshes {
-        m.check_finite()
-            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
+        m.check_finite().map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     }
     write_atomic(path, |w| match format {
         Format::Obj => write_obj(w, meshes),

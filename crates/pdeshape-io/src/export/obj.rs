@@ -31,14 +31,7 @@ pub fn write_obj(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
             }
         };
         for q in &m.quads {
-            writeln!(
-                w,
-                "f {} {} {} {}",
-                vert(q[0]),
-                vert(q[1]),
-                vert(q[2]),
-                vert(q[3])
-            )?;
+            writeln!(w, "f {} {} {} {}", vert(q[0]), vert(q[1]), vert(q[2]), vert(q[3]))?;
         }
         for t in &m.triangles {
             writeln!(w, "f {} {} {}", vert(t[0]), vert(t[1]), vert(t[2]))?;

@@ -8,10 +8,7 @@ use std::io::{self, Write};
 /// (`list uchar int`). Meshes without normals or UVs get zeros.
 pub fn write_ply(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
     let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
-    let nf: usize = meshes
-        .iter()
-        .map(|m| m.quads.len() + m.triangles.len())
-        .sum();
+    let nf: usize = meshes.iter().map(|m| m.quads.len() + m.triangles.len()).sum();
     let fields: Vec<String> = meshes
         .first()
         .map(|m| {
@@ -22,10 +19,7 @@ pub fn write_ply(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
                 .collect()
         })
         .unwrap_or_default();
-    write!(
-        w,
-        "ply\nformat binary_little_endian 1.0\ncomment pdeshape export\n"
-    )?;
+    write!(w, "ply\nformat binary_little_endian 1.0\ncomment pdeshape export\n")?;
     for m in meshes {
         writeln!(
             w,
@@ -42,10 +36,7 @@ pub fn write_ply(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
     for f in &fields {
         writeln!(w, "property float {}", sanitize(f))?;
     }
-    write!(
-        w,
-        "element face {nf}\nproperty list uchar int vertex_indices\nend_header\n"
-    )?;
+    write!(w, "element face {nf}\nproperty list uchar int vertex_indices\nend_header\n")?;
     for m in meshes {
         for (i, p) in m.positions.iter().enumerate() {
             for c in p.to_array() {
@@ -85,13 +76,5 @@ pub fn write_ply(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
 }
 
 fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect()
 }

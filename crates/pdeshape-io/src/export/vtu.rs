@@ -14,17 +14,11 @@ fn header(w: &mut dyn Write, npts: usize, ncells: usize) -> io::Result<()> {
         w,
         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
-    writeln!(
-        w,
-        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{npts}\" NumberOfCells=\"{ncells}\">"
-    )
+    writeln!(w, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{npts}\" NumberOfCells=\"{ncells}\">")
 }
 
 fn points(w: &mut dyn Write, pts: &[Vec3]) -> io::Result<()> {
-    writeln!(
-        w,
-        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
-    )?;
+    writeln!(w, "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">")?;
     for p in pts {
         writeln!(w, "{:?} {:?} {:?}", p.x, p.y, p.z)?;
     }
@@ -32,33 +26,17 @@ fn points(w: &mut dyn Write, pts: &[Vec3]) -> io::Result<()> {
 }
 
 fn cells(w: &mut dyn Write, conn: &[Vec<u32>], types: &[u8]) -> io::Result<()> {
-    writeln!(
-        w,
-        "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
-    )?;
+    writeln!(w, "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">")?;
     for c in conn {
-        writeln!(
-            w,
-            "{}",
-            c.iter()
-                .map(|i| i.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        )?;
+        writeln!(w, "{}", c.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" "))?;
     }
-    writeln!(
-        w,
-        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
-    )?;
+    writeln!(w, "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">")?;
     let mut off = 0;
     for c in conn {
         off += c.len();
         writeln!(w, "{off}")?;
     }
-    writeln!(
-        w,
-        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
-    )?;
+    writeln!(w, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">")?;
     for t in types {
         writeln!(w, "{t}")?;
     }
@@ -66,11 +44,7 @@ fn cells(w: &mut dyn Write, conn: &[Vec<u32>], types: &[u8]) -> io::Result<()> {
 }
 
 fn scalar(w: &mut dyn Write, f: &ScalarField) -> io::Result<()> {
-    writeln!(
-        w,
-        "<DataArray type=\"Float64\" Name=\"{}\" format=\"ascii\">",
-        xml_name(&f.name)
-    )?;
+    writeln!(w, "<DataArray type=\"Float64\" Name=\"{}\" format=\"ascii\">", xml_name(&f.name))?;
     for x in &f.values {
         writeln!(w, "{x:?}")?;
     }
@@ -78,15 +52,7 @@ fn scalar(w: &mut dyn Write, f: &ScalarField) -> io::Result<()> {
 }
 
 fn xml_name(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
 }
 
 fn footer(w: &mut dyn Write) -> io::Result<()> {
@@ -96,10 +62,7 @@ fn footer(w: &mut dyn Write) -> io::Result<()> {
 /// Writes surface meshes as one unstructured grid of quads and triangles, with normals,
 /// the patch index (`patch`, a cell field) and every scalar field present in all meshes.
 pub fn write_vtu_surface(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> {
-    let pts: Vec<Vec3> = meshes
-        .iter()
-        .flat_map(|m| m.positions.iter().copied())
-        .collect();
+    let pts: Vec<Vec3> = meshes.iter().flat_map(|m| m.positions.iter().copied()).collect();
     let mut conn = Vec::new();
     let mut types = Vec::new();
     let mut patch_id = Vec::new();
@@ -122,10 +85,7 @@ pub fn write_vtu_surface(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> 
     cells(w, &conn, &types)?;
     writeln!(w, "<PointData>")?;
     if meshes.iter().all(|m| m.normals.len() == m.positions.len()) && !pts.is_empty() {
-        writeln!(
-            w,
-            "<DataArray type=\"Float64\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">"
-        )?;
+        writeln!(w, "<DataArray type=\"Float64\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">")?;
         for n in meshes.iter().flat_map(|m| m.normals.iter()) {
             writeln!(w, "{:?} {:?} {:?}", n.x, n.y, n.z)?;
         }
@@ -136,30 +96,14 @@ pub fn write_vtu_surface(w: &mut dyn Write, meshes: &[&Mesh]) -> io::Result<()> 
             if meshes.iter().all(|m| m.field(&f.name).is_some()) {
                 let values = meshes
                     .iter()
-                    .flat_map(|m| {
-                        m.field(&f.name)
-                            .map(|f| f.values.clone())
-                            .unwrap_or_default()
-                    })
+                    .flat_map(|m| m.field(&f.name).map(|f| f.values.clone()).unwrap_or_default())
                     .collect();
-                scalar(
-                    w,
-                    &ScalarField {
-                        name: f.name.clone(),
-                        values,
-                    },
-                )?;
+                scalar(w, &ScalarField { name: f.name.clone(), values })?;
             }
         }
     }
     writeln!(w, "</PointData>\n<CellData>")?;
-    scalar(
-        w,
-        &ScalarField {
-            name: "patch".into(),
-            values: patch_id,
-        },
-    )?;
+    scalar(w, &ScalarField { name: "patch".into(), values: patch_id })?;
     writeln!(w, "</CellData>")?;
     footer(w)
 }

@@ -20,11 +20,7 @@ impl Image {
         for _ in 0..width * height {
             data.extend_from_slice(&[rgb[0], rgb[1], rgb[2], 255]);
         }
-        Image {
-            width,
-            height,
-            data,
-        }
+        Image { width, height, data }
     }
 
     /// Blends `rgb` with coverage `a ∈ [0, 1]` into pixel `(x, y)` (ignored outside).
@@ -34,9 +30,9 @@ impl Image {
         }
         let i = ((y as u32 * self.width + x as u32) * 4) as usize;
         let a = a.min(1.0);
-        for k in 0..3 {
-            let old = self.data[i + k] as f32;
-            self.data[i + k] = (old + (rgb[k] as f32 - old) * a).round() as u8;
+        for (d, &c) in self.data[i..i + 3].iter_mut().zip(&rgb) {
+            let old = *d as f32;
+            *d = (old + (c as f32 - old) * a).round() as u8;
         }
     }
 
@@ -75,8 +71,7 @@ impl Image {
 
     /// Places images side by side (top-aligned) on a background.
     pub fn strip(images: &[Image], gap: u32, bg: [u8; 3]) -> Image {
-        let w = images.iter().map(|i| i.width).sum::<u32>()
-            + gap * images.len().saturating_sub(1) as u32;
+        let w = images.iter().map(|i| i.width).sum::<u32>() + gap * images.len().saturating_sub(1) as u32;
         let h = images.iter().map(|i| i.height).max().unwrap_or(1);
         let mut out = Image::new(w.max(1), h, bg);
         let mut x = 0;

@@ -33,14 +33,10 @@ pub fn colormap(x: f64) -> [f32; 3] {
         [0.254, 0.265, 0.530],
         [0.164, 0.471, 0.558],
         [0.135, 0.659, 0.518],
-        [0.478, 0.821, 0.318],
+        [0.478, 0.821, 0.319],
         [0.993, 0.906, 0.144],
     ];
-    let x = if x.is_finite() {
-        x.clamp(0.0, 1.0)
-    } else {
-        0.0
-    } * 5.0;
+    let x = if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 } * 5.0;
     let i = (x.floor() as usize).min(4);
     let f = (x - i as f64) as f32;
     std::array::from_fn(|k| C[i][k] * (1.0 - f) + C[i + 1][k] * f)

@@ -18,11 +18,7 @@ fn register_font() {
     ONCE.call_once(|| {
         // The bytes are 'static, so registration cannot fail for lifetime reasons; an
         // unparsable font would only lose the labels.
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            epaint_default_fonts::UBUNTU_LIGHT,
-        );
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
     });
 }
 
@@ -53,15 +49,10 @@ pub fn line_plot(
     if all.is_empty() {
         return Err(format!("plot `{title}` has no finite points"));
     }
-    let (mut x0, mut x1, mut y0, mut y1) = all.iter().fold(
-        (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ),
-        |a, p| (a.0.min(p.0), a.1.max(p.0), a.2.min(p.1), a.3.max(p.1)),
-    );
+    let (mut x0, mut x1, mut y0, mut y1) =
+        all.iter().fold((f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.0), a.1.max(p.0), a.2.min(p.1), a.3.max(p.1))
+        });
     if x1 <= x0 {
         x0 -= 1.0;
         x1 += 1.0;
@@ -81,11 +72,7 @@ pub fn line_plot(
             .y_label_area_size(64)
             .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
             .map_err(|e| e.to_string())?;
-        let ylab = if log_y {
-            format!("log10 {ylabel}")
-        } else {
-            ylabel.to_string()
-        };
+        let ylab = if log_y { format!("log10 {ylabel}") } else { ylabel.to_string() };
         chart
             .configure_mesh()
             .x_desc(xlabel)
@@ -95,21 +82,13 @@ pub fn line_plot(
             .map_err(|e| e.to_string())?;
         for (k, (s, p)) in series.iter().zip(&pts).enumerate() {
             let c = super::PALETTE[k % super::PALETTE.len()];
-            let col = RGBColor(
-                (c[0] * 200.0) as u8,
-                (c[1] * 200.0) as u8,
-                (c[2] * 200.0) as u8,
-            );
+            let col = RGBColor((c[0] * 200.0) as u8, (c[1] * 200.0) as u8, (c[2] * 200.0) as u8);
             chart
                 .draw_series(LineSeries::new(p.iter().copied(), col.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(s.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                });
-            chart
-                .draw_series(p.iter().map(|q| Circle::new(*q, 3, col.filled())))
-                .map_err(|e| e.to_string())?;
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            chart.draw_series(p.iter().map(|q| Circle::new(*q, 3, col.filled()))).map_err(|e| e.to_string())?;
         }
         chart
             .configure_series_labels()

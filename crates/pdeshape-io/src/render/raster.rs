@@ -80,10 +80,7 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
     let center = (lo + hi) * 0.5;
     let (az, el) = (cam.azimuth.to_radians(), cam.elevation.to_radians());
     let toward = Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
-    let right = Vec3::new(0.0, 0.0, 1.0)
-        .cross(toward)
-        .normalized()
-        .unwrap_or(Vec3::new(0.0, 1.0, 0.0));
+    let right = Vec3::new(0.0, 0.0, 1.0).cross(toward).normalized().unwrap_or(Vec3::new(0.0, 1.0, 0.0));
     let up = toward.cross(right);
     // Fit the projected bounding box.
     let mut ext: f64 = 1e-12;
@@ -96,15 +93,7 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
         ext = ext.max((c.dot(right).abs() / w as f64).max(c.dot(up).abs() / h as f64));
     }
     let scale = 0.46 / ext * cam.zoom;
-    let view = View {
-        center,
-        right,
-        up,
-        toward,
-        scale,
-        w,
-        h,
-    };
+    let view = View { center, right, up, toward, scale, w, h };
 
     let mut color = vec![[0f32; 3]; w * h];
     for y in 0..h {
@@ -113,23 +102,14 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
         color[y * w..(y + 1) * w].fill(c);
     }
     let mut depth = vec![f64::NEG_INFINITY; w * h];
-    let light = (toward * 0.7 + up * 0.6 + right * -0.35)
-        .normalized()
-        .unwrap_or(toward);
-    let fill = (toward * 0.6 + right * 0.7 - up * 0.2)
-        .normalized()
-        .unwrap_or(toward);
+    let light = (toward * 0.7 + up * 0.6 + right * -0.35).normalized().unwrap_or(toward);
+    let fill = (toward * 0.6 + right * 0.7 - up * 0.2).normalized().unwrap_or(toward);
 
     for it in items {
         let m = it.mesh;
         let proj: Vec<(f64, f64, f64)> = m.positions.iter().map(|p| view.project(*p)).collect();
         let field = it.field.as_ref().and_then(|n| m.field(n)).map(|f| {
-            let (a, b) = f
-                .values
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                    (a.min(*x), b.max(*x))
-                });
+            let (a, b) = f.values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
             (f, a, if b > a { b - a } else { 1.0 })
         });
         let vcol: Vec<[f32; 3]> = (0..m.positions.len())
@@ -140,42 +120,25 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
             .collect();
         for t in m.all_triangles() {
             let [a, b, c] = t.map(|i| i as usize);
-            raster_triangle(
-                &view,
-                &mut color,
-                &mut depth,
-                [proj[a], proj[b], proj[c]],
-                |l0, l1, l2| {
-                    let n = if m.normals.is_empty() {
-                        (m.positions[b] - m.positions[a]).cross(m.positions[c] - m.positions[a])
-                    } else {
-                        m.normals[a] * l0 + m.normals[b] * l1 + m.normals[c] * l2
-                    };
-                    let mut n = n.normalized().unwrap_or(toward);
-                    if n.dot(toward) < 0.0 {
-                        n = -n;
-                    }
-                    let base: [f32; 3] = std::array::from_fn(|k| {
-                        vcol[a][k] * l0 as f32 + vcol[b][k] * l1 as f32 + vcol[c][k] * l2 as f32
-                    });
-                    shade(base, n, light, fill, toward)
-                },
-            );
+            raster_triangle(&view, &mut color, &mut depth, [proj[a], proj[b], proj[c]], |l0, l1, l2| {
+                let n = if m.normals.is_empty() {
+                    (m.positions[b] - m.positions[a]).cross(m.positions[c] - m.positions[a])
+                } else {
+                    m.normals[a] * l0 + m.normals[b] * l1 + m.normals[c] * l2
+                };
+                let mut n = n.normalized().unwrap_or(toward);
+                if n.dot(toward) < 0.0 {
+                    n = -n;
+                }
+                let base: [f32; 3] =
+                    std::array::from_fn(|k| vcol[a][k] * l0 as f32 + vcol[b][k] * l1 as f32 + vcol[c][k] * l2 as f32);
+                shade(base, n, light, fill, toward)
+            });
         }
         if it.wireframe {
             let edge = [0.15f32, 0.18, 0.25];
             let mut draw = |i: u32, j: u32| {
-                line(
-                    &mut color,
-                    &depth,
-                    w,
-                    h,
-                    proj[i as usize],
-                    proj[j as usize],
-                    edge,
-                    0.45,
-                    1.0,
-                );
+                line(&mut color, &depth, w, h, proj[i as usize], proj[j as usize], edge, 0.45, 1.0);
             };
             for q in &m.quads {
                 draw(q[0], q[1]);
@@ -192,17 +155,7 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
         for curve in &m.curves {
             let pts: Vec<(f64, f64, f64)> = curve.iter().map(|p| view.project(*p)).collect();
             for s in pts.windows(2) {
-                line(
-                    &mut color,
-                    &depth,
-                    w,
-                    h,
-                    s[0],
-                    s[1],
-                    [0.70, 0.10, 0.10],
-                    1.0,
-                    2.2 * SS as f64,
-                );
+                line(&mut color, &depth, w, h, s[0], s[1], [0.70, 0.10, 0.10], 1.0, 2.2 * SS as f64);
             }
         }
     }
@@ -228,30 +181,10 @@ fn raster_triangle(
     if area.abs() < 1e-12 || !area.is_finite() {
         return;
     }
-    let xmin = p
-        .iter()
-        .map(|q| q.0)
-        .fold(f64::INFINITY, f64::min)
-        .floor()
-        .max(0.0) as usize;
-    let xmax = p
-        .iter()
-        .map(|q| q.0)
-        .fold(f64::NEG_INFINITY, f64::max)
-        .ceil()
-        .min(v.w as f64 - 1.0);
-    let ymin = p
-        .iter()
-        .map(|q| q.1)
-        .fold(f64::INFINITY, f64::min)
-        .floor()
-        .max(0.0) as usize;
-    let ymax = p
-        .iter()
-        .map(|q| q.1)
-        .fold(f64::NEG_INFINITY, f64::max)
-        .ceil()
-        .min(v.h as f64 - 1.0);
+    let xmin = p.iter().map(|q| q.0).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
+    let xmax = p.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max).ceil().min(v.w as f64 - 1.0);
+    let ymin = p.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
+    let ymax = p.iter().map(|q| q.1).fold(f64::NEG_INFINITY, f64::max).ceil().min(v.h as f64 - 1.0);
     if xmax < 0.0 || ymax < 0.0 {
         return;
     }
@@ -296,11 +229,7 @@ fn line(
     let tol = 1e-3 * (1.0 + a.2.abs().max(b.2.abs()));
     for s in 0..=steps {
         let t = s as f64 / steps as f64;
-        let (x, y, z) = (
-            a.0 + (b.0 - a.0) * t,
-            a.1 + (b.1 - a.1) * t,
-            a.2 + (b.2 - a.2) * t,
-        );
+        let (x, y, z) = (a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, a.2 + (b.2 - a.2) * t);
         let (x0, x1) = ((x - r).floor() as i64, (x + r).ceil() as i64);
         let (y0, y1) = ((y - r).floor() as i64, (y + r).ceil() as i64);
         for py in y0..=y1 {
@@ -332,14 +261,14 @@ fn downsample(c: &[[f32; 3]], w: usize, _h: usize, ow: u32, oh: u32) -> Image {
             for dy in 0..s {
                 for dx in 0..s {
                     let p = c[(y * s + dy) * w + x * s + dx];
-                    for k in 0..3 {
-                        acc[k] += p[k];
+                    for (a, q) in acc.iter_mut().zip(p) {
+                        *a += q;
                     }
                 }
             }
             let i = (y * ow as usize + x) * 4;
-            for k in 0..3 {
-                img.data[i + k] = (acc[k] / (s * s) as f32 * 255.0).round().clamp(0.0, 255.0) as u8;
+            for (d, a) in img.data[i..i + 3].iter_mut().zip(acc) {
+                *d = (a / (s * s) as f32 * 255.0).round().clamp(0.0, 255.0) as u8;
             }
         }
     }

@@ -27,14 +27,7 @@ pub fn draw_text(img: &mut Image, x: f32, y: f32, size: f32, text: &str, rgb: [u
             prev = Some(id);
             if let Some(og) = font.outline_glyph(g) {
                 let b = og.px_bounds();
-                og.draw(|gx, gy, c| {
-                    img.blend(
-                        b.min.x as i64 + gx as i64,
-                        b.min.y as i64 + gy as i64,
-                        rgb,
-                        c,
-                    )
-                });
+                og.draw(|gx, gy, c| img.blend(b.min.x as i64 + gx as i64, b.min.y as i64 + gy as i64, rgb, c));
             }
         }
         max_w = max_w.max(caret - x);

@@ -5,10 +5,8 @@ use super::raw::*;
 use super::{Param, PatchKind, RenderSettings, Scene, ScenePatch, SceneSurface};
 use indexmap::IndexMap;
 use pdeshape_core::Vec3;
-use pdeshape_core::data::{
-    BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative,
-};
-use pdeshape_core::expr::{BinOp, Expr, Func, Node};
+use pdeshape_core::data::{BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative};
+use pdeshape_core::expr::{BinOp, Expr, ExprError, Func, Node};
 use pdeshape_core::patch::{Condition, HermitePatch, VDomain};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -55,12 +53,22 @@ fn toml_error(src: &Source, e: toml::de::Error) -> SceneError {
 }
 
 impl Ctx<'_> {
-    fn err(
-        &self,
-        span: Option<Range<usize>>,
-        key: impl Into<String>,
-        msg: impl Into<String>,
-    ) -> SceneError {
+    /// An expression error located at its exact character: the expression text is looked
+    /// up inside the TOML value it came from, and the error's offset added.
+    fn expr_err(&self, sp: Option<Range<usize>>, key: impl Into<String>, text: &str, e: &ExprError) -> SceneError {
+        let exact = sp.as_ref().and_then(|r| {
+            let hay = self.src.text.get(r.clone())?;
+            let at = hay.find(text)?;
+            let start = r.start + at + e.span.start.min(text.len());
+            Some(start..start + 1)
+        });
+        match exact {
+            Some(r) => self.err(Some(r), key, format!("{} (in `{text}`)", e.message)),
+            None => self.err(sp, key, e.with_source_ref(text).to_string()),
+        }
+    }
+
+    fn err(&self, span: Option<Range<usize>>, key: impl Into<String>, msg: impl Into<String>) -> SceneError {
         self.src.error(span, key, msg)
     }
 
@@ -73,10 +81,8 @@ impl Ctx<'_> {
         let v = match x {
             NumOrExpr::Num(v) => *v,
             NumOrExpr::Expr(s) => {
-                let e = Expr::parse(s).map_err(|e| self.err(sp.clone(), key, e.to_string()))?;
-                let b = e
-                    .bind(&[], &self.param_lookup())
-                    .map_err(|e| self.err(sp.clone(), key, e.with_source(s).to_string()))?;
+                let e = Expr::parse(s).map_err(|e| self.expr_err(sp.clone(), key, s, &e))?;
+                let b = e.bind(&[], &self.param_lookup()).map_err(|e| self.expr_err(sp.clone(), key, s, &e))?;
                 b.eval(&[])
             }
         };
@@ -87,11 +93,7 @@ impl Ctx<'_> {
     }
 
     fn vec3(&self, x: &[NumOrExpr; 3], sp: Option<Range<usize>>, key: &str) -> R<Vec3> {
-        Ok(Vec3::new(
-            self.num(&x[0], sp.clone(), key)?,
-            self.num(&x[1], sp.clone(), key)?,
-            self.num(&x[2], sp, key)?,
-        ))
+        Ok(Vec3::new(self.num(&x[0], sp.clone(), key)?, self.num(&x[1], sp.clone(), key)?, self.num(&x[2], sp, key)?))
     }
 
     fn field(&self, x: &Spanned<[NumOrExpr; 3]>, vars: &[&str], key: &str) -> R<ExprField> {
@@ -103,28 +105,14 @@ impl Ctx<'_> {
                 NumOrExpr::Expr(s) => s.clone(),
             })
             .collect();
-        ExprField::parse(
-            [&texts[0], &texts[1], &texts[2]],
-            vars,
-            &self.param_lookup(),
-        )
-        .map_err(|(i, e)| {
-            self.err(
-                span(x),
-                format!("{key}[{i}]"),
-                e.with_source(&texts[i]).to_string(),
-            )
-        })
+        ExprField::parse([&texts[0], &texts[1], &texts[2]], vars, &self.param_lookup())
+            .map_err(|(i, e)| self.expr_err(span(x), format!("{key}[{i}]"), &texts[i], &e))
     }
 
     fn int(&self, x: &Spanned<i64>, lo: i64, hi: i64, key: &str) -> R<i64> {
         let v = *x.get_ref();
         if v < lo || v > hi {
-            return Err(self.err(
-                span(x),
-                key,
-                format!("{v} is out of range (expected {lo} … {hi})"),
-            ));
+            return Err(self.err(span(x), key, format!("{v} is out of range (expected {lo} … {hi})")));
         }
         Ok(v)
     }
@@ -133,11 +121,7 @@ impl Ctx<'_> {
         let a = self.num(&x.get_ref()[0], span(x), key)?;
         let b = self.num(&x.get_ref()[1], span(x), key)?;
         if b <= a {
-            return Err(self.err(
-                span(x),
-                key,
-                format!("empty range [{a}, {b}] (expected start < end)"),
-            ));
+            return Err(self.err(span(x), key, format!("empty range [{a}, {b}] (expected start < end)")));
         }
         Ok((a, b))
     }
@@ -148,11 +132,9 @@ impl Ctx<'_> {
         };
         match x.get_ref() {
             RawDomain::Word(w) if w == "periodic" => Ok(VDomain::PERIODIC),
-            RawDomain::Word(w) => Err(self.err(
-                span(x),
-                key,
-                format!("unknown v domain `{w}` (expected \"periodic\" or [v0, v1])"),
-            )),
+            RawDomain::Word(w) => {
+                Err(self.err(span(x), key, format!("unknown v domain `{w}` (expected \"periodic\" or [v0, v1])")))
+            }
             RawDomain::Range(r) => {
                 let a = self.num(&r[0], span(x), key)?;
                 let b = self.num(&r[1], span(x), key)?;
@@ -164,12 +146,7 @@ impl Ctx<'_> {
         }
     }
 
-    fn resolution(
-        &self,
-        x: &Option<Spanned<[i64; 2]>>,
-        default: (usize, usize),
-        key: &str,
-    ) -> R<(usize, usize)> {
+    fn resolution(&self, x: &Option<Spanned<[i64; 2]>>, default: (usize, usize), key: &str) -> R<(usize, usize)> {
         let Some(x) = x else { return Ok(default) };
         let [a, b] = *x.get_ref();
         if a < 2 || b < 2 {
@@ -183,9 +160,7 @@ impl Ctx<'_> {
             return Err(self.err(
                 span(x),
                 key,
-                format!(
-                    "resolution [{a}, {b}] exceeds the limit of {MAX_VERTICES} vertices per patch"
-                ),
+                format!("resolution [{a}, {b}] exceeds the limit of {MAX_VERTICES} vertices per patch"),
             ));
         }
         Ok((a as usize, b as usize))
@@ -199,45 +174,26 @@ fn check_name(
     key: &str,
     taken: &mut HashMap<String, String>,
 ) -> R<()> {
-    let valid = name
-        .chars()
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    let valid = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if !valid {
         return Err(src.error(
             sp,
             key,
-            format!(
-                "`{name}` is not a valid name (letters, digits, `_`, `-`; starting with a letter)"
-            ),
+            format!("`{name}` is not a valid name (letters, digits, `_`, `-`; starting with a letter)"),
         ));
     }
     if is_reserved(name) {
-        return Err(src.error(
-            sp,
-            key,
-            format!("`{name}` is reserved (a variable, constant or function name)"),
-        ));
+        return Err(src.error(sp, key, format!("`{name}` is reserved (a variable, constant or function name)")));
     }
     if let Some(prev) = taken.get(name) {
-        return Err(src.error(
-            sp,
-            key,
-            format!("the name `{name}` is already used by {prev}"),
-        ));
+        return Err(src.error(sp, key, format!("the name `{name}` is already used by {prev}")));
     }
     taken.insert(name.to_string(), key.to_string());
     Ok(())
 }
 
-fn build_params(
-    ctx: &mut Ctx,
-    raw: &IndexMap<String, Spanned<RawParam>>,
-    overrides: &HashMap<String, f64>,
-) -> R<()> {
+fn build_params(ctx: &mut Ctx, raw: &IndexMap<String, Spanned<RawParam>>, overrides: &HashMap<String, f64>) -> R<()> {
     for name in overrides.keys() {
         if !raw.contains_key(name) {
             return Err(ctx.err(None, "parameters", format!("unknown parameter `{name}`")));
@@ -270,10 +226,7 @@ fn build_params(
                 return Err(src.error(
                     span(&raw[name]),
                     format!("parameters.{name}"),
-                    format!(
-                        "parameters depend on each other in a cycle: {}",
-                        cyc[start..].join(" → ")
-                    ),
+                    format!("parameters depend on each other in a cycle: {}", cyc[start..].join(" → ")),
                 ));
             }
             St::Todo => {}
@@ -292,14 +245,10 @@ fn build_params(
                 NumOrExpr::Expr(text) => {
                     state.insert(name, St::Busy);
                     stack.push(name);
-                    let e =
-                        Expr::parse(text).map_err(|e| src.error(span(p), &key, e.to_string()))?;
+                    let e = Expr::parse(text).map_err(|e| src.error(span(p), &key, e.to_string()))?;
                     for id in e.identifiers() {
                         if raw.contains_key(&id) {
-                            let id_ref = raw
-                                .get_key_value(&id)
-                                .map(|(k, _)| k.as_str())
-                                .unwrap_or("");
+                            let id_ref = raw.get_key_value(&id).map(|(k, _)| k.as_str()).unwrap_or("");
                             visit(id_ref, raw, overrides, state, values, stack, src)?;
                         }
                     }
@@ -321,15 +270,7 @@ fn build_params(
 
     for name in raw.keys() {
         let mut stack = Vec::new();
-        visit(
-            name,
-            raw,
-            overrides,
-            &mut state,
-            &mut values,
-            &mut stack,
-            &ctx.src,
-        )?;
+        visit(name, raw, overrides, &mut state, &mut values, &mut stack, &ctx.src)?;
     }
     for (name, p) in raw {
         let (expr, min, max, step, description) = match p.get_ref() {
@@ -346,26 +287,16 @@ fn build_params(
                 t.description.clone(),
             ),
         };
-        if let (Some(a), Some(b)) = (min, max) {
-            if !(a.is_finite() && b.is_finite() && a < b) {
-                return Err(ctx.err(
-                    span(p),
-                    format!("parameters.{name}"),
-                    format!("slider range [{a}, {b}] is empty or not finite"),
-                ));
-            }
+        if let (Some(a), Some(b)) = (min, max)
+            && !(a.is_finite() && b.is_finite() && a < b)
+        {
+            return Err(ctx.err(
+                span(p),
+                format!("parameters.{name}"),
+                format!("slider range [{a}, {b}] is empty or not finite"),
+            ));
         }
-        ctx.params.insert(
-            name.clone(),
-            Param {
-                value: values[name],
-                expr,
-                min,
-                max,
-                step,
-                description,
-            },
-        );
+        ctx.params.insert(name.clone(), Param { value: values[name], expr, min, max, step, description });
     }
     Ok(())
 }
@@ -376,11 +307,7 @@ enum Lin {
     Vector(Vec<(f64, String)>, Vec3),
 }
 
-fn linear(
-    e: &Expr,
-    is_curve: &dyn Fn(&str) -> bool,
-    param: &dyn Fn(&str) -> Option<f64>,
-) -> Result<Lin, String> {
+fn linear(e: &Expr, is_curve: &dyn Fn(&str) -> bool, param: &dyn Fn(&str) -> Option<f64>) -> Result<Lin, String> {
     use Lin::*;
     Ok(match &e.node {
         Node::Num(x) => Scalar(*x),
@@ -401,7 +328,9 @@ fn linear(
         Node::Bin(op, a, b) => {
             let (x, y) = (linear(a, is_curve, param)?, linear(b, is_curve, param)?);
             match (op, x, y) {
-                (BinOp::Add | BinOp::Sub, Scalar(x), Scalar(y)) => Scalar(if *op == BinOp::Add { x + y } else { x - y }),
+                (BinOp::Add | BinOp::Sub, Scalar(x), Scalar(y)) => {
+                    Scalar(if *op == BinOp::Add { x + y } else { x - y })
+                }
                 (BinOp::Add | BinOp::Sub, Vector(mut t, c), Vector(u, d)) => {
                     let s = if *op == BinOp::Add { 1.0 } else { -1.0 };
                     t.extend(u.into_iter().map(|(w, n)| (s * w, n)));
@@ -410,11 +339,18 @@ fn linear(
                 (BinOp::Mul, Scalar(x), Vector(t, c)) | (BinOp::Mul, Vector(t, c), Scalar(x)) => {
                     Vector(t.into_iter().map(|(w, n)| (w * x, n)).collect(), c * x)
                 }
-                (BinOp::Div, Vector(t, c), Scalar(x)) => Vector(t.into_iter().map(|(w, n)| (w / x, n)).collect(), c / x),
+                (BinOp::Div, Vector(t, c), Scalar(x)) => {
+                    Vector(t.into_iter().map(|(w, n)| (w / x, n)).collect(), c / x)
+                }
                 (BinOp::Mul, Scalar(x), Scalar(y)) => Scalar(x * y),
                 (BinOp::Div, Scalar(x), Scalar(y)) => Scalar(x / y),
                 (BinOp::Pow, Scalar(x), Scalar(y)) => Scalar(x.powf(y)),
-                _ => return Err("not a linear combination of curves (curves may be added, subtracted and scaled by numbers)".into()),
+                _ => {
+                    return Err(
+                        "not a linear combination of curves (curves may be added, subtracted and scaled by numbers)"
+                            .into(),
+                    );
+                }
             }
         }
         Node::Call(f, args) => {
@@ -423,17 +359,11 @@ fn linear(
                 match linear(a, is_curve, param)? {
                     Scalar(x) => xs.push(x),
                     _ => {
-                        return Err(format!(
-                            "`{}` of a curve is not a linear combination",
-                            f.name()
-                        ));
+                        return Err(format!("`{}` of a curve is not a linear combination", f.name()));
                     }
                 }
             }
-            let e = Expr {
-                node: Node::Call(*f, xs.into_iter().map(Expr::num).collect()),
-                span: e.span,
-            };
+            let e = Expr { node: Node::Call(*f, xs.into_iter().map(Expr::num).collect()), span: e.span };
             Scalar(e.bind(&[], &|_| None).map_err(|e| e.message)?.eval(&[]))
         }
         Node::Var(_) => return Err("unexpected variable".into()),
@@ -461,10 +391,7 @@ impl CurveBuilder<'_, '_> {
             return Err(self.ctx.err(
                 span(rc),
                 key,
-                format!(
-                    "curves depend on each other in a cycle: {}",
-                    cyc.join(" → ")
-                ),
+                format!("curves depend on each other in a cycle: {}", cyc.join(" → ")),
             ));
         }
         self.busy.push(name.to_string());
@@ -491,41 +418,23 @@ impl CurveBuilder<'_, '_> {
         .collect();
         if sources.len() != 1 {
             let msg = if sources.is_empty() {
-                "the curve has no definition (expected one of: expr, bspline, polyline, point, combine, surface)".to_string()
+                "the curve has no definition (expected one of: expr, bspline, polyline, point, combine, surface)"
+                    .to_string()
             } else {
-                format!(
-                    "the curve has several definitions ({}); give exactly one",
-                    sources.join(", ")
-                )
+                format!("the curve has several definitions ({}); give exactly one", sources.join(", "))
             };
             return Err(ctx.err(span(rc), key, msg));
         }
         let only_for = |present: bool, what: &str, allowed: &str| -> R<()> {
             if present {
-                return Err(ctx.err(
-                    span(rc),
-                    key,
-                    format!("`{what}` only applies to {allowed} curves"),
-                ));
+                return Err(ctx.err(span(rc), key, format!("`{what}` only applies to {allowed} curves")));
             }
             Ok(())
         };
         let spline_like = c.bspline.is_some() || c.polyline.is_some();
-        only_for(
-            !spline_like && c.closed.is_some(),
-            "closed",
-            "bspline and polyline",
-        )?;
-        only_for(
-            !spline_like && c.range.is_some(),
-            "range",
-            "bspline and polyline",
-        )?;
-        only_for(
-            c.bspline.is_none() && c.degree.is_some(),
-            "degree",
-            "bspline",
-        )?;
+        only_for(!spline_like && c.closed.is_some(), "closed", "bspline and polyline")?;
+        only_for(!spline_like && c.range.is_some(), "range", "bspline and polyline")?;
+        only_for(c.bspline.is_none() && c.degree.is_some(), "degree", "bspline")?;
         let trim = c.surface.is_some();
         only_for(
             !trim && (c.s.is_some() || c.derivative.is_some() || c.scale.is_some()),
@@ -534,11 +443,7 @@ impl CurveBuilder<'_, '_> {
         )?;
 
         if let Some(x) = &c.expr {
-            return Ok(Arc::new(ctx.field(
-                x,
-                &["v", "t"],
-                &format!("{key}.expr"),
-            )?));
+            return Ok(Arc::new(ctx.field(x, &["v", "t"], &format!("{key}.expr"))?));
         }
         if let Some(x) = &c.point {
             return Ok(Arc::new(PointField {
@@ -566,26 +471,21 @@ impl CurveBuilder<'_, '_> {
                 None if closed => (0.0, 2.0 * std::f64::consts::PI),
                 None => (0.0, 1.0),
             };
-            if !closed
-                && points.len() >= 2
-                && (points[0] - points[points.len() - 1]).norm() == 0.0
-                && points.len() > 2
+            if !closed && points.len() >= 2 && (points[0] - points[points.len() - 1]).norm() == 0.0 && points.len() > 2
             {
                 // A repeated end point on an open curve is legitimate (a closed polygon as an
                 // open spline); nothing to do.
             }
-            let curve = BSplineCurve::new(points, degree, closed, range)
-                .map_err(|e| ctx.err(span(pts), &k, e.to_string()))?;
+            let curve =
+                BSplineCurve::new(points, degree, closed, range).map_err(|e| ctx.err(span(pts), &k, e.to_string()))?;
             return Ok(Arc::new(curve));
         }
         if let Some(text) = &c.combine {
             let k = format!("{key}.combine");
-            let e =
-                Expr::parse(text.get_ref()).map_err(|e| ctx.err(span(text), &k, e.to_string()))?;
+            let e = Expr::parse(text.get_ref()).map_err(|e| ctx.expr_err(span(text), &k, text.get_ref(), &e))?;
             let names: Vec<String> = self.raw.keys().cloned().collect();
             let is_curve = |n: &str| names.iter().any(|m| m == n);
-            let lin = linear(&e, &is_curve, &ctx.param_lookup())
-                .map_err(|m| ctx.err(span(text), &k, m))?;
+            let lin = linear(&e, &is_curve, &ctx.param_lookup()).map_err(|m| ctx.err(span(text), &k, m))?;
             let Lin::Vector(terms, constant) = lin else {
                 return Err(ctx.err(
                     span(text),
@@ -596,50 +496,31 @@ impl CurveBuilder<'_, '_> {
             let mut fields = Vec::new();
             for (w, n) in terms {
                 if n == name {
-                    return Err(ctx.err(
-                        span(text),
-                        &k,
-                        format!("the curve `{name}` refers to itself"),
-                    ));
+                    return Err(ctx.err(span(text), &k, format!("the curve `{name}` refers to itself")));
                 }
                 if !w.is_finite() {
-                    return Err(ctx.err(
-                        span(text),
-                        &k,
-                        format!("the weight of `{n}` is not finite"),
-                    ));
+                    return Err(ctx.err(span(text), &k, format!("the weight of `{n}` is not finite")));
                 }
                 fields.push((w, self.get(&n)?));
             }
             return Ok(Arc::new(Combination::new(fields, constant)));
         }
         if let Some(sname) = &c.surface {
-            let surf = self
-                .surfaces
-                .iter()
-                .find(|s| s.name == *sname.get_ref())
-                .ok_or_else(|| {
-                    ctx.err(
-                        span(sname),
-                        format!("{key}.surface"),
-                        format!(
-                            "unknown surface `{}` (defined: {})",
-                            sname.get_ref(),
-                            self.surfaces
-                                .iter()
-                                .map(|s| s.name.as_str())
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    )
-                })?;
-            let s = c.s.as_ref().ok_or_else(|| {
+            let surf = self.surfaces.iter().find(|s| s.name == *sname.get_ref()).ok_or_else(|| {
                 ctx.err(
-                    span(rc),
-                    key,
-                    "a trimline needs `s`, the surface parameter of the trimline",
+                    span(sname),
+                    format!("{key}.surface"),
+                    format!(
+                        "unknown surface `{}` (defined: {})",
+                        sname.get_ref(),
+                        self.surfaces.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
                 )
             })?;
+            let s = c
+                .s
+                .as_ref()
+                .ok_or_else(|| ctx.err(span(rc), key, "a trimline needs `s`, the surface parameter of the trimline"))?;
             let s0 = ctx.num(s.get_ref(), span(s), &format!("{key}.s"))?;
             let d = match &c.derivative {
                 Some(d) => ctx.int(d, 0, 6, &format!("{key}.derivative"))? as usize,
@@ -657,10 +538,7 @@ impl CurveBuilder<'_, '_> {
 
 pub(super) fn build(src: Source, name: &str, overrides: &HashMap<String, f64>) -> R<Scene> {
     let raw: RawScene = toml::from_str(src.text).map_err(|e| toml_error(&src, e))?;
-    let mut ctx = Ctx {
-        src: src.clone(),
-        params: IndexMap::new(),
-    };
+    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new() };
     let mut taken: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.parameters {
         check_name(&src, n, span(p), &format!("parameters.{n}"), &mut taken)?;
@@ -681,39 +559,19 @@ pub(super) fn build(src: Source, name: &str, overrides: &HashMap<String, f64>) -
     for (n, s) in &raw.surfaces {
         let key = format!("surfaces.{n}");
         let rs = s.get_ref();
-        let field: FieldRef =
-            Arc::new(ctx.field(&rs.expr, &["s", "v", "t"], &format!("{key}.expr"))?);
-        let s_range = rs
-            .s_range
-            .as_ref()
-            .map(|r| ctx.range(r, &format!("{key}.s_range")))
-            .transpose()?;
+        let field: FieldRef = Arc::new(ctx.field(&rs.expr, &["s", "v", "t"], &format!("{key}.expr"))?);
+        let s_range = rs.s_range.as_ref().map(|r| ctx.range(r, &format!("{key}.s_range"))).transpose()?;
         let domain = ctx.domain(&rs.v, &format!("{key}.v"))?;
         let resolution = ctx.resolution(&rs.resolution, (17, 65), &format!("{key}.resolution"))?;
-        surfaces.push(SceneSurface {
-            name: n.clone(),
-            field,
-            s_range,
-            domain,
-            resolution,
-        });
+        surfaces.push(SceneSurface { name: n.clone(), field, s_range, domain, resolution });
     }
 
-    let mut cb = CurveBuilder {
-        ctx: &ctx,
-        raw: &raw.curves,
-        surfaces: &surfaces,
-        done: IndexMap::new(),
-        busy: Vec::new(),
-    };
+    let mut cb =
+        CurveBuilder { ctx: &ctx, raw: &raw.curves, surfaces: &surfaces, done: IndexMap::new(), busy: Vec::new() };
     for n in raw.curves.keys() {
         cb.get(n)?;
     }
-    let curves: IndexMap<String, FieldRef> = raw
-        .curves
-        .keys()
-        .map(|n| (n.clone(), cb.done[n].clone()))
-        .collect();
+    let curves: IndexMap<String, FieldRef> = raw.curves.keys().map(|n| (n.clone(), cb.done[n].clone())).collect();
 
     let mut patches = Vec::new();
     for (pname, p) in &raw.patches {
@@ -727,22 +585,14 @@ pub(super) fn build(src: Source, name: &str, overrides: &HashMap<String, f64>) -
     }
     if let Some(e) = r.elevation {
         if !(-90.0..=90.0).contains(&e) {
-            return Err(ctx.err(
-                None,
-                "render.elevation",
-                format!("{e} is out of range (expected -90 … 90 degrees)"),
-            ));
+            return Err(ctx.err(None, "render.elevation", format!("{e} is out of range (expected -90 … 90 degrees)")));
         }
         render.elevation = e;
     }
     if let Some(sz) = &r.size {
         let [w, h] = *sz.get_ref();
         if !(16..=8192).contains(&w) || !(16..=8192).contains(&h) {
-            return Err(ctx.err(
-                span(sz),
-                "render.size",
-                format!("[{w}, {h}] is out of range (16 … 8192 pixels)"),
-            ));
+            return Err(ctx.err(span(sz), "render.size", format!("[{w}, {h}] is out of range (16 … 8192 pixels)")));
         }
         render.size = (w as u32, h as u32);
     }
@@ -764,11 +614,7 @@ pub(super) fn build(src: Source, name: &str, overrides: &HashMap<String, f64>) -
                     return Err(ctx.err(
                         span(f),
                         "output.formats",
-                        format!(
-                            "unknown format `{}` (known: {})",
-                            f.get_ref(),
-                            FORMATS.join(", ")
-                        ),
+                        format!("unknown format `{}` (known: {})", f.get_ref(), FORMATS.join(", ")),
                     ));
                 }
                 out.push(f.get_ref().clone());
@@ -830,38 +676,21 @@ fn build_patch(
         let c = rc.get_ref();
         let u = ctx.num(c.u.get_ref(), span(&c.u), &format!("{ck}.u"))?;
         if !(0.0..=1.0).contains(&u) {
-            return Err(ctx.err(
-                span(&c.u),
-                format!("{ck}.u"),
-                format!("u = {u} is outside [0, 1]"),
-            ));
+            return Err(ctx.err(span(&c.u), format!("{ck}.u"), format!("u = {u} is outside [0, 1]")));
         }
         let order = match &c.order {
             Some(o) => ctx.int(o, 0, 12, &format!("{ck}.order"))? as usize,
             None => 0,
         };
-        let n_src = [
-            c.curve.is_some(),
-            c.expr.is_some(),
-            c.point.is_some(),
-            c.surface.is_some(),
-        ]
-        .iter()
-        .filter(|b| **b)
-        .count();
+        let n_src = [c.curve.is_some(), c.expr.is_some(), c.point.is_some(), c.surface.is_some()]
+            .iter()
+            .filter(|b| **b)
+            .count();
         if n_src != 1 {
-            return Err(ctx.err(
-                span(rc),
-                &ck,
-                "a condition needs exactly one of: curve, expr, point, surface",
-            ));
+            return Err(ctx.err(span(rc), &ck, "a condition needs exactly one of: curve, expr, point, surface"));
         }
         if c.surface.is_none() && (c.s.is_some() || c.scale.is_some()) {
-            return Err(ctx.err(
-                span(rc),
-                &ck,
-                "`s` and `scale` only apply to trimline conditions (with `surface`)",
-            ));
+            return Err(ctx.err(span(rc), &ck, "`s` and `scale` only apply to trimline conditions (with `surface`)"));
         }
         let data: FieldRef = if let Some(n) = &c.curve {
             curves.get(n.get_ref()).cloned().ok_or_else(|| {
@@ -882,25 +711,13 @@ fn build_patch(
         } else if let Some(x) = &c.expr {
             Arc::new(ctx.field(x, &["v", "t"], &format!("{ck}.expr"))?)
         } else if let Some(x) = &c.point {
-            Arc::new(PointField {
-                point: ctx.vec3(x.get_ref(), span(x), &format!("{ck}.point"))?,
-                arity: 1,
-            })
+            Arc::new(PointField { point: ctx.vec3(x.get_ref(), span(x), &format!("{ck}.point"))?, arity: 1 })
         } else {
             let sname = c.surface.as_ref().expect("counted above");
-            let surf = surfaces
-                .iter()
-                .find(|s| s.name == *sname.get_ref())
-                .ok_or_else(|| {
-                    ctx.err(
-                        span(sname),
-                        format!("{ck}.surface"),
-                        format!("unknown surface `{}`", sname.get_ref()),
-                    )
-                })?;
-            let s =
-                c.s.as_ref()
-                    .ok_or_else(|| ctx.err(span(rc), &ck, "a trimline condition needs `s`"))?;
+            let surf = surfaces.iter().find(|s| s.name == *sname.get_ref()).ok_or_else(|| {
+                ctx.err(span(sname), format!("{ck}.surface"), format!("unknown surface `{}`", sname.get_ref()))
+            })?;
+            let s = c.s.as_ref().ok_or_else(|| ctx.err(span(rc), &ck, "a trimline condition needs `s`"))?;
             let s0 = ctx.num(s.get_ref(), span(s), &format!("{ck}.s"))?;
             let scale = match &c.scale {
                 Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ck}.scale"))?,
@@ -916,40 +733,20 @@ fn build_patch(
             .map_err(|e| ctx.err(span(rconds), format!("{key}.conditions"), e.to_string()))?,
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    Ok(ScenePatch {
-        name: pname.to_string(),
-        kind,
-        surface: Arc::new(surface),
-        conditions,
-        resolution,
-        color,
-    })
+    Ok(ScenePatch { name: pname.to_string(), kind, surface: Arc::new(surface), conditions, resolution, color })
 }
 
 /// Checks that condition data are finite on the domain and, for a periodic patch, closed.
-fn check_data(
-    ctx: &Ctx,
-    data: &FieldRef,
-    domain: VDomain,
-    sp: Option<Range<usize>>,
-    key: &str,
-) -> R<()> {
+fn check_data(ctx: &Ctx, data: &FieldRef, domain: VDomain, sp: Option<Range<usize>>, key: &str) -> R<()> {
     for k in 0..=64 {
         let v = domain.at(k as f64 / 64.0);
         let g = data.eval(&[v, 0.0]);
         if !g.is_finite() {
-            return Err(ctx.err(
-                sp,
-                key,
-                format!("the data are not finite at v = {v:.6} (value {g:?})"),
-            ));
+            return Err(ctx.err(sp, key, format!("the data are not finite at v = {v:.6} (value {g:?})")));
         }
     }
     if domain.periodic {
-        let (a, b) = (
-            data.eval(&[domain.start, 0.0]),
-            data.eval(&[domain.end, 0.0]),
-        );
+        let (a, b) = (data.eval(&[domain.start, 0.0]), data.eval(&[domain.end, 0.0]));
         let (da, db) = (
             curve_derivative(data.as_ref(), domain.start, 0.0, 1),
             curve_derivative(data.as_ref(), domain.end, 0.0, 1),

@@ -54,12 +54,7 @@ pub struct Source<'a> {
 
 impl Source<'_> {
     /// An error at byte `span` (or without a place).
-    pub fn error(
-        &self,
-        span: Option<Range<usize>>,
-        key: impl Into<String>,
-        message: impl Into<String>,
-    ) -> SceneError {
+    pub fn error(&self, span: Option<Range<usize>>, key: impl Into<String>, message: impl Into<String>) -> SceneError {
         let (line, column, snippet) = match span {
             Some(r) => {
                 let start = r.start.min(self.text.len());
@@ -67,22 +62,11 @@ impl Source<'_> {
                 let line = before.matches('\n').count() + 1;
                 let line_start = before.rfind('\n').map(|i| i + 1).unwrap_or(0);
                 let col = self.text[line_start..start].chars().count() + 1;
-                let line_text = self.text[line_start..]
-                    .lines()
-                    .next()
-                    .unwrap_or("")
-                    .to_string();
+                let line_text = self.text[line_start..].lines().next().unwrap_or("").to_string();
                 (Some(line), Some(col), Some(line_text))
             }
             None => (None, None, None),
         };
-        SceneError {
-            file: self.file.to_string(),
-            line,
-            column,
-            key: key.into(),
-            message: message.into(),
-            snippet,
-        }
+        SceneError { file: self.file.to_string(), line, column, key: key.into(), message: message.into(), snippet }
     }
 }

@@ -4,6 +4,10 @@
 //! The format is documented, with every key, in `examples/README.md`. Errors name the
 //! file, line, column and key, and say what was expected.
 
+// Scene errors carry the place and a source snippet; they are built once per failed load,
+// so their size on the error path does not matter.
+#![allow(clippy::result_large_err)]
+
 mod build;
 mod error;
 mod raw;
@@ -112,14 +116,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings {
-            azimuth: 35.0,
-            elevation: 25.0,
-            size: (800, 600),
-            wireframe: false,
-            field: None,
-            zoom: 1.0,
-        }
+        RenderSettings { azimuth: 35.0, elevation: 25.0, size: (800, 600), wireframe: false, field: None, zoom: 1.0 }
     }
 }
 
@@ -164,21 +161,13 @@ impl Scene {
             message: format!("cannot read the scene file: {e}"),
             snippet: None,
         })?;
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "scene".into());
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
         Scene::parse(&text, &file, &name, &HashMap::new())
     }
 
     /// Parses scene text. `overrides` replace parameter values (by name) before anything
     /// is resolved — the live editor's sliders.
-    pub fn parse(
-        text: &str,
-        file: &str,
-        name: &str,
-        overrides: &HashMap<String, f64>,
-    ) -> Result<Scene, SceneError> {
+    pub fn parse(text: &str, file: &str, name: &str, overrides: &HashMap<String, f64>) -> Result<Scene, SceneError> {
         build::build(Source { file, text }, name, overrides)
     }
 

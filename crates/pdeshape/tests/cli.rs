@@ -1,0 +1,111 @@
+//! The CLI end to end: sample round-trips, check, build into directories, gallery.
+
+use assert_cmd::Command;
+use std::path::PathBuf;
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
+}
+
+/// `sample` prints the Hermite blend of examples/hermite-blend.toml; compare with the
+/// formula X = H00 C(z0) + H01 (−k0) ∂C/∂s + H10 P(r1) + H11 k1 ∂P/∂s, written out here.
+#[test]
+fn sample_round_trips_the_hermite_formula() {
+    let (r, z0, r1, k0, k1) = (1.0f64, 1.5, 2.5, 1.5, 1.5);
+    let mut input = String::from("u,v\n");
+    let mut pts = Vec::new();
+    for i in 0..=10 {
+        for j in 0..=12 {
+            let (u, v) = (i as f64 / 10.0, j as f64 * 0.51);
+            pts.push((u, v));
+            input.push_str(&format!("{u},{v}\n"));
+        }
+    }
+    let out = Command::cargo_bin("pdeshape").unwrap().arg("sample").arg(example("hermite-blend.toml")).write_stdin(input).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("u,v,x,y,z"));
+    let mut n = 0;
+    for (line, (u, v)) in lines.zip(&pts) {
+        let c: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        assert_eq!((c[0], c[1]), (*u, *v));
+        let h00 = 1.0 - 3.0 * u * u + 2.0 * u * u * u;
+        let h01 = u - 2.0 * u * u + u * u * u;
+        let h10 = 3.0 * u * u - 2.0 * u * u * u;
+        let h11 = u * u * u - u * u;
+        let x = h00 * r * v.cos() + h10 * r1 * v.cos() + h11 * k1 * v.cos();
+        let y = h00 * r * v.sin() + h10 * r1 * v.sin() + h11 * k1 * v.sin();
+        let z = h00 * z0 - h01 * k0;
+        for (got, want) in [(c[2], x), (c[3], y), (c[4], z)] {
+            assert!((got - want).abs() <= 1e-14, "at ({u}, {v}): {got} vs {want}");
+        }
+        n += 1;
+    }
+    assert_eq!(n, pts.len());
+}
+
+#[test]
+fn check_json_reports_exact_conditions() {
+    let out = Command::cargo_bin("pdeshape").unwrap().arg("check").arg("--json").arg(example("hermite-blend.toml")).output().unwrap();
+    assert!(out.status.success());
+    let d: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let p = &d["patches"][0];
+    assert_eq!(p["kind"], "hermite");
+    assert!(p["condition_error"]["max_rel"].as_f64().unwrap() < 1e-12);
+    assert_eq!(p["condition_error"]["samples"], 1000);
+}
+
+#[test]
+fn build_writes_every_format() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["obj", "ply", "stl", "glb", "vtu", "png"] {
+        let out = dir.path().join(format!("m.{ext}"));
+        Command::cargo_bin("pdeshape").unwrap().args(["build", "-q"]).arg(example("hermite-pole.toml")).arg("-o").arg(&out).assert().success();
+        assert!(std::fs::metadata(&out).unwrap().len() > 100, "{ext}");
+    }
+    let sub = dir.path().join("outdir");
+    Command::cargo_bin("pdeshape").unwrap().args(["build", "-q"]).arg(example("hermite-pole.toml")).arg("-o").arg(&sub).assert().success();
+    let mut names: Vec<String> = std::fs::read_dir(&sub).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["hermite-pole-cone.obj", "hermite-pole-strip.obj", "hermite-pole.png"]);
+}
+
+#[test]
+fn set_overrides_a_parameter() {
+    let run = |set: &[&str]| {
+        let mut c = Command::cargo_bin("pdeshape").unwrap();
+        c.arg("sample").arg(example("hermite-blend.toml"));
+        for s in set {
+            c.arg("--set").arg(s);
+        }
+        let o = c.write_stdin("0,0\n").output().unwrap();
+        assert!(o.status.success());
+        String::from_utf8(o.stdout).unwrap().lines().nth(1).unwrap().split(',').nth(2).unwrap().parse::<f64>().unwrap()
+    };
+    assert_eq!(run(&[]), 1.0);
+    assert_eq!(run(&["r=1.75"]), 1.75);
+}
+
+#[test]
+fn gallery_builds_an_index_with_pictures() {
+    let dir = tempfile::tempdir().unwrap();
+    Command::cargo_bin("pdeshape").unwrap().arg("gallery").arg(dir.path()).arg("-q").assert().success();
+    let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+    let n_examples = std::fs::read_dir(example("")).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "toml")).count();
+    assert_eq!(html.matches("<img ").count(), n_examples);
+    for img in html.split("<img src=\"").skip(1) {
+        let path = img.split('"').next().unwrap();
+        let bytes = std::fs::read(dir.path().join(path)).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+    }
+}
+
+#[test]
+fn not_yet_available_commands_say_so() {
+    for cmd in ["bench", "serve"] {
+        let o = Command::cargo_bin("pdeshape").unwrap().arg(cmd).output().unwrap();
+        assert_eq!(o.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("not available"));
+    }
+}
