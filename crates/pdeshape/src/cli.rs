@@ -188,7 +188,12 @@ fn execute(cli: Cli) -> Result<()> {
                 write_meshes(&out, fmt, &refs).with_context(|| format!("cannot write {}", out.display()))?;
                 if !cli.quiet {
                     let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
-                    eprintln!("wrote {} ({} patch{}, {nv} vertices)", out.display(), meshes.len(), if meshes.len() == 1 { "" } else { "es" });
+                    eprintln!(
+                        "wrote {} ({} patch{}, {nv} vertices)",
+                        out.display(),
+                        meshes.len(),
+                        if meshes.len() == 1 { "" } else { "es" }
+                    );
                 }
             } else if !ext.is_empty() {
                 bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)");

@@ -21,7 +21,13 @@ fn sample_round_trips_the_hermite_formula() {
             input.push_str(&format!("{u},{v}\n"));
         }
     }
-    let out = Command::cargo_bin("pdeshape").unwrap().arg("sample").arg(example("hermite-blend.toml")).write_stdin(input).output().unwrap();
+    let out = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .arg("sample")
+        .arg(example("hermite-blend.toml"))
+        .write_stdin(input)
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
@@ -47,7 +53,13 @@ fn sample_round_trips_the_hermite_formula() {
 
 #[test]
 fn check_json_reports_exact_conditions() {
-    let out = Command::cargo_bin("pdeshape").unwrap().arg("check").arg("--json").arg(example("hermite-blend.toml")).output().unwrap();
+    let out = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .arg("check")
+        .arg("--json")
+        .arg(example("hermite-blend.toml"))
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let d: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let p = &d["patches"][0];
@@ -61,12 +73,27 @@ fn build_writes_every_format() {
     let dir = tempfile::tempdir().unwrap();
     for ext in ["obj", "ply", "stl", "glb", "vtu", "png"] {
         let out = dir.path().join(format!("m.{ext}"));
-        Command::cargo_bin("pdeshape").unwrap().args(["build", "-q"]).arg(example("hermite-pole.toml")).arg("-o").arg(&out).assert().success();
+        Command::cargo_bin("pdeshape")
+            .unwrap()
+            .args(["build", "-q"])
+            .arg(example("hermite-pole.toml"))
+            .arg("-o")
+            .arg(&out)
+            .assert()
+            .success();
         assert!(std::fs::metadata(&out).unwrap().len() > 100, "{ext}");
     }
     let sub = dir.path().join("outdir");
-    Command::cargo_bin("pdeshape").unwrap().args(["build", "-q"]).arg(example("hermite-pole.toml")).arg("-o").arg(&sub).assert().success();
-    let mut names: Vec<String> = std::fs::read_dir(&sub).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["build", "-q"])
+        .arg(example("hermite-pole.toml"))
+        .arg("-o")
+        .arg(&sub)
+        .assert()
+        .success();
+    let mut names: Vec<String> =
+        std::fs::read_dir(&sub).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
     assert_eq!(names, ["hermite-pole-cone.obj", "hermite-pole-strip.obj", "hermite-pole.png"]);
 }
@@ -92,7 +119,10 @@ fn gallery_builds_an_index_with_pictures() {
     let dir = tempfile::tempdir().unwrap();
     Command::cargo_bin("pdeshape").unwrap().arg("gallery").arg(dir.path()).arg("-q").assert().success();
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
-    let n_examples = std::fs::read_dir(example("")).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "toml")).count();
+    let n_examples = std::fs::read_dir(example(""))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "toml"))
+        .count();
     assert_eq!(html.matches("<img ").count(), n_examples);
     for img in html.split("<img src=\"").skip(1) {
         let path = img.split('"').next().unwrap();

@@ -159,3 +159,50 @@ pub fn curve_derivative(f: &dyn Field, v: f64, t: f64, k: usize) -> Vec3 {
     let at = [v, t];
     f.jet(&at, JetShape::new(&[k])).derivative([k, 0, 0])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::fourier::{FourierSeries, sample_count};
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A finite Fourier series is recovered exactly (to round-off) by the FFT analysis.
+        #[test]
+        fn fft_recovers_finite_series(coefs in proptest::collection::vec(-2.0f64..2.0, 18)) {
+            let m = 4;
+            let f = |t: f64| {
+                let mut p = Vec3::new(coefs[0], coefs[1], 0.0);
+                for n in 1..=m {
+                    let (s, c) = (n as f64 * t).sin_cos();
+                    p.x += coefs[2 * n] * c + coefs[2 * n + 1] * s;
+                    p.z += coefs[8 + n] * c;
+                }
+                p
+            };
+            let s = FourierSeries::analyse(f, m, sample_count(m));
+            for k in 0..20 {
+                let t = 0.31 * k as f64;
+                prop_assert!((s.eval(t) - f(t)).norm() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn even_extension_is_continuous_periodic_and_cosine_only() {
+        let g: FieldRef = Arc::new(FnField::new(1, |p| [p[0].clone(), p[0].mul(&p[0]), p[0].exp()]));
+        let e = EvenExtension::new(g.clone(), 0.5, 2.0);
+        let pi = std::f64::consts::PI;
+        assert!((e.eval(&[0.0]) - g.eval(&[0.5])).norm() < 1e-15);
+        assert!((e.eval(&[pi]) - g.eval(&[2.0])).norm() < 1e-15);
+        assert!((e.eval(&[2.0 * pi - 0.3]) - e.eval(&[0.3])).norm() < 1e-14);
+        // dθ-derivative on the reflected half has the opposite sign
+        let d1 = curve_derivative(&e, 0.3, 0.0, 1);
+        let d2 = curve_derivative(&e, 2.0 * pi - 0.3, 0.0, 1);
+        assert!((d1 + d2).norm() < 1e-13);
+        let s = FourierSeries::analyse(|t| e.eval(&[t]), 16, 256);
+        assert!(s.b.iter().all(|b| b.norm() < 1e-13), "sine coefficients of an even function vanish");
+        // coefficients decay like 1/n²
+        assert!(s.a[15].norm() < 2.0 * s.a[3].norm() * (3.0f64 / 15.0).powi(2) + 1e-12);
+    }
+}

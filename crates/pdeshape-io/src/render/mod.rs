@@ -41,3 +41,20 @@ pub fn colormap(x: f64) -> [f32; 3] {
     let f = (x - i as f64) as f32;
     std::array::from_fn(|k| C[i][k] * (1.0 - f) + C[i + 1][k] * f)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plots_and_text_draw_pixels() {
+        let s = Series { label: "error".into(), points: (1..8).map(|k| (k as f64, 10f64.powi(-k))).collect() };
+        let img = line_plot("convergence", "M", "error", &[s], true, (400, 300)).unwrap();
+        let dark = img.data.chunks(4).filter(|p| p[0] < 100).count();
+        assert!(dark > 500, "the plot draws axes, labels and a line ({dark} dark pixels)");
+        let mut im = Image::new(200, 40, [255, 255, 255]);
+        let w = draw_text(&mut im, 2.0, 2.0, 20.0, "C1 gap 1e-12", [0, 0, 0]);
+        assert!(w > 50.0);
+        assert!(im.data.chunks(4).any(|p| p[0] < 50));
+    }
+}

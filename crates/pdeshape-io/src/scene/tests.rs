@@ -1,1 +1,72 @@
+//! Scene resolution: parameters, curve kinds, trimlines, overrides.
 
+use super::*;
+use pdeshape_core::Vec3;
+use pdeshape_core::data::curve_derivative;
+use pdeshape_core::jet::JetShape;
+
+fn parse(text: &str) -> Scene {
+    Scene::parse(text, "test.toml", "test", &HashMap::new()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const BASE: &str = r#"
+[parameters]
+r = 2.0
+d = "3*r - 1"
+h = { value = 0.5, min = 0, max = 1 }
+
+[surfaces.cyl]
+expr = ["r*cos(v)", "r*sin(v)", "s^2"]
+
+[curves.c]
+expr = ["d*cos(v)", "d*sin(v)", "h"]
+
+[curves.p]
+point = [0, 0, "h + 1"]
+
+[curves.lin]
+combine = "2*(c - p) + p/2"
+
+[curves.tg]
+surface = "cyl"
+s = 1.5
+derivative = 1
+scale = -2
+
+[patches.x]
+kind = "hermite"
+conditions = [{ u = 0, curve = "c" }, { u = 1, curve = "tg" }]
+"#;
+
+#[test]
+fn derived_parameters_and_overrides() {
+    let s = parse(BASE);
+    assert_eq!(s.params["d"].value, 5.0);
+    assert_eq!(s.params["d"].expr.as_deref(), Some("3*r - 1"));
+    assert_eq!((s.params["h"].min, s.params["h"].max), (Some(0.0), Some(1.0)));
+    let o = Scene::parse(BASE, "t", "t", &HashMap::from([("r".to_string(), 1.0)])).unwrap();
+    assert_eq!(o.params["d"].value, 2.0, "derived parameters follow overrides");
+}
+
+#[test]
+fn combinations_and_trimlines_evaluate_exactly() {
+    let s = parse(BASE);
+    let v = 0.7f64;
+    let c = Vec3::new(5.0 * v.cos(), 5.0 * v.sin(), 0.5);
+    let p = Vec3::new(0.0, 0.0, 1.5);
+    let lin = s.curves["lin"].eval(&[v, 0.0]);
+    assert!((lin - ((c - p) * 2.0 + p * 0.5)).norm() < 1e-14);
+    // t = −2 ∂S/∂s at s = 1.5: (0, 0, −2·2s) = (0, 0, −6); its v-derivative is zero
+    let t = s.curves["tg"].eval(&[v, 0.0]);
+    assert!((t - Vec3::new(0.0, 0.0, -6.0)).norm() < 1e-14);
+    assert!(curve_derivative(s.curves["tg"].as_ref(), v, 0.0, 2).norm() < 1e-14);
+    // the position trimline keeps v-derivatives: d²/dv² of (r cos v, r sin v) = −(r cos v, r sin v)
+    let j = s.curves["c"].jet(&[v, 0.0], JetShape::new(&[2]));
+    assert!((j.derivative([2, 0, 0]) + Vec3::new(5.0 * v.cos(), 5.0 * v.sin(), 0.0)).norm() < 1e-13);
+}
+
+#[test]
+fn parameters_keep_file_order() {
+    let s = parse(BASE);
+    assert_eq!(s.params.keys().collect::<Vec<_>>(), ["r", "d", "h"]);
+}
