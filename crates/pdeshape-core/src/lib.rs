@@ -20,6 +20,7 @@ pub mod expr;
 pub mod jet;
 pub mod linalg;
 pub mod mesh;
+pub mod ode;
 pub mod patch;
 mod vec3;
 

@@ -1,0 +1,157 @@
+//! Cardinal functions of a condition set.
+
+use super::ExpSpace;
+use crate::linalg::{LinalgError, SquareSolver};
+use faer::Mat;
+
+/// A condition `y^{(order)}(u) = …` of the boundary-value problem.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CondSpec {
+    /// Where.
+    pub u: f64,
+    /// Derivative order.
+    pub order: usize,
+}
+
+/// A boundary-value problem that has no unique solution.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum OdeError {
+    /// The number of conditions is not the order of the ODE.
+    #[error("{got} conditions for an ODE of order {dim}: exactly {dim} are needed")]
+    Count {
+        /// Conditions given.
+        got: usize,
+        /// ODE order.
+        dim: usize,
+    },
+    /// Two conditions are identical.
+    #[error("conditions {0} and {1} are identical (both ∂^{2} at u = {3}): they clash")]
+    Duplicate(usize, usize, usize, f64),
+    /// The condition matrix is singular.
+    #[error("the conditions do not determine a unique solution (condition number {cond:.2e}{detail})")]
+    Singular {
+        /// Condition number.
+        cond: f64,
+        /// Which conditions, when known.
+        detail: String,
+    },
+}
+
+/// The cardinal functions `ℓ_i ∈ K` of a condition set: `ℓ_i^{(d_k)}(u_k) = δ_ik`.
+///
+/// ```
+/// use pdeshape_core::ode::{Cardinal, CondSpec, ExpSpace};
+/// // Cubic Hermite interpolation is the case c = 0, N = 2 with value and slope at 0 and 1.
+/// let conds = [CondSpec { u: 0.0, order: 0 }, CondSpec { u: 0.0, order: 1 },
+///              CondSpec { u: 1.0, order: 0 }, CondSpec { u: 1.0, order: 1 }];
+/// let l = Cardinal::new(ExpSpace::symmetric(0.0, 2), &conds).unwrap();
+/// let v = l.eval(0.5, 0);
+/// assert!((v[0][0] - 0.5).abs() < 1e-14 && (v[0][3] + 0.125).abs() < 1e-14);
+/// ```
+#[derive(Clone, Debug)]
+pub struct Cardinal {
+    space: ExpSpace,
+    conds: Vec<CondSpec>,
+    /// Column i: the basis coefficients of ℓ_i.
+    coef: Mat<f64>,
+    cond: f64,
+}
+
+/// Largest condition number accepted for the condition matrix in f64.
+pub const MAX_COND: f64 = 1e13;
+
+impl Cardinal {
+    /// Solves for the cardinal functions of `conds` in `space`.
+    pub fn new(space: ExpSpace, conds: &[CondSpec]) -> Result<Self, OdeError> {
+        let n = space.dim();
+        if conds.len() != n {
+            return Err(OdeError::Count { got: conds.len(), dim: n });
+        }
+        for i in 0..n {
+            for j in i + 1..n {
+                if conds[i].u == conds[j].u && conds[i].order == conds[j].order {
+                    return Err(OdeError::Duplicate(i, j, conds[i].order, conds[i].u));
+                }
+            }
+        }
+        let kmax = conds.iter().map(|c| c.order).max().unwrap_or(0);
+        // Φ[i][b] = φ_b^{(d_i)}(u_i)
+        let rows: Vec<Vec<f64>> = conds.iter().map(|c| space.derivatives(c.u, kmax)[c.order].clone()).collect();
+        let phi = Mat::from_fn(n, n, |i, b| rows[i][b]);
+        let solver = SquareSolver::new(&phi, MAX_COND).map_err(|e| match e {
+            LinalgError::Singular { cond } => OdeError::Singular { cond, detail: String::new() },
+            _ => OdeError::Singular { cond: f64::INFINITY, detail: format!(": {e}") },
+        })?;
+        // ℓ = φ · Φ⁻¹ : coefficients C = Φ⁻¹ (column i ↦ ℓ_i).
+        let coef = solver.solve(&Mat::<f64>::identity(n, n));
+        Ok(Cardinal { space, conds: conds.to_vec(), coef, cond: solver.cond() })
+    }
+
+    /// `out[k][i] = ℓ_i^{(k)}(u)` for `k = 0 … kmax`.
+    pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
+        let d = self.space.derivatives(u, kmax);
+        let n = self.space.dim();
+        d.iter().map(|row| (0..n).map(|i| (0..n).map(|b| row[b] * self.coef[(b, i)]).sum()).collect()).collect()
+    }
+
+    /// The 2-norm condition number of the condition matrix in the bounded basis.
+    pub fn condition_number(&self) -> f64 {
+        self.cond
+    }
+
+    /// The conditions.
+    pub fn conditions(&self) -> &[CondSpec] {
+        &self.conds
+    }
+
+    /// The space.
+    pub fn space(&self) -> &ExpSpace {
+        &self.space
+    }
+
+    /// The Lebesgue constant `max_u Σ_i |ℓ_i(u)|` estimated on `samples` equispaced points
+    /// (and the condition points): the factor by which the data can be amplified between
+    /// the conditions.
+    pub fn lebesgue(&self, samples: usize) -> f64 {
+        let pts = (0..=samples).map(|k| k as f64 / samples as f64).chain(self.conds.iter().map(|c| c.u));
+        pts.map(|u| self.eval(u, 0)[0].iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check_cardinal(l: &Cardinal, tol: f64) {
+        let kmax = l.conditions().iter().map(|c| c.order).max().unwrap();
+        for (k, c) in l.conditions().iter().enumerate() {
+            let v = l.eval(c.u, kmax);
+            for i in 0..v[0].len() {
+                let want = if i == k { 1.0 } else { 0.0 };
+                assert!((v[c.order][i] - want).abs() < tol, "ℓ_{i}^({})({}) = {}", c.order, c.u, v[c.order][i]);
+            }
+        }
+    }
+
+    #[test]
+    fn cardinal_functions_meet_their_conditions() {
+        let four = [0.0, 0.3, 0.7, 1.0].map(|u| CondSpec { u, order: 0 });
+        for c in [0.0, 0.5, 1.1, 4.4, 25.0] {
+            check_cardinal(&Cardinal::new(ExpSpace::symmetric(c, 2), &four).unwrap(), 1e-12);
+        }
+        let mixed = [(0.0, 0), (0.0, 1), (0.0, 2), (0.5, 0), (1.0, 0), (1.0, 1), (1.0, 2), (0.5, 3)]
+            .map(|(u, order)| CondSpec { u, order });
+        for c in [0.0, 1.0, 3.0, 12.0] {
+            check_cardinal(&Cardinal::new(ExpSpace::symmetric(c, 4), &mixed).unwrap(), 1e-10);
+        }
+    }
+
+    #[test]
+    fn clashing_conditions_are_named() {
+        let dup = [(0.0, 0), (0.5, 0), (0.5, 0), (1.0, 0)].map(|(u, order)| CondSpec { u, order });
+        let e = Cardinal::new(ExpSpace::symmetric(1.0, 2), &dup).unwrap_err();
+        assert_eq!(e, OdeError::Duplicate(1, 2, 0, 0.5));
+        let few = [CondSpec { u: 0.0, order: 0 }];
+        assert!(matches!(Cardinal::new(ExpSpace::symmetric(1.0, 2), &few), Err(OdeError::Count { .. })));
+    }
+}
