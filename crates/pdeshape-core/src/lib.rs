@@ -22,6 +22,7 @@ pub mod linalg;
 pub mod mesh;
 pub mod ode;
 pub mod patch;
+pub mod spectral;
 mod vec3;
 
 pub use vec3::Vec3;

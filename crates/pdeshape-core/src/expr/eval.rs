@@ -32,6 +32,13 @@ pub(super) fn apply_f64(f: Func, a: &[f64]) -> f64 {
                 a[0]
             }
         }
+        Func::Select => {
+            if a[0] > 0.0 {
+                a[1]
+            } else {
+                a[2]
+            }
+        }
     }
 }
 
@@ -56,6 +63,13 @@ fn apply_jet(f: Func, a: &[Jet]) -> Jet {
         Func::Atan2 => Jet::atan2(&a[0], &a[1]),
         Func::Min => a[0].min(&a[1]),
         Func::Max => a[0].max(&a[1]),
+        Func::Select => {
+            if a[0].value() > 0.0 {
+                a[1].clone()
+            } else {
+                a[2].clone()
+            }
+        }
     }
 }
 
@@ -79,7 +93,8 @@ impl Expr {
             }
             Node::Call(f, args) => match args.len() {
                 1 => apply_f64(*f, &[args[0].eval(vars)]),
-                _ => apply_f64(*f, &[args[0].eval(vars), args[1].eval(vars)]),
+                2 => apply_f64(*f, &[args[0].eval(vars), args[1].eval(vars)]),
+                _ => apply_f64(*f, &[args[0].eval(vars), args[1].eval(vars), args[2].eval(vars)]),
             },
             Node::Ident(n) => panic!("unbound identifier `{n}` evaluated"),
         }

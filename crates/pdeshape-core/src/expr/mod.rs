@@ -9,7 +9,7 @@
 //!
 //! Operators `+ - * / ^` (`^` is right-associative and binds tighter than unary minus, so
 //! `-v^2 = -(v²)`), functions `sin cos tan sinh cosh tanh exp ln sqrt abs atan pow atan2 min
-//! max`, constants `pi` and `e`. Parsing yields an [`Expr`] whose identifiers are resolved
+//! max select`, constants `pi` and `e` (`select(x, a, b)` is `a` where `x > 0`, else `b`). Parsing yields an [`Expr`] whose identifiers are resolved
 //! by [`Expr::bind`] into variable slots and parameter values; evaluation is available as
 //! plain `f64` ([`Expr::eval`]) and as exact truncated Taylor series ([`Expr::eval_jet`]),
 //! which gives every partial derivative up to any order exactly (see [`crate::jet`]).
@@ -71,11 +71,13 @@ pub enum Func {
     Min,
     /// max(x, y)
     Max,
+    /// select(x, a, b) = a where x > 0, else b (piecewise definitions)
+    Select,
 }
 
 impl Func {
     /// All functions with their names (`log` is accepted as a synonym of `ln`).
-    pub const ALL: [(&'static str, Func); 15] = [
+    pub const ALL: [(&'static str, Func); 16] = [
         ("sin", Func::Sin),
         ("cos", Func::Cos),
         ("tan", Func::Tan),
@@ -91,6 +93,7 @@ impl Func {
         ("atan2", Func::Atan2),
         ("min", Func::Min),
         ("max", Func::Max),
+        ("select", Func::Select),
     ];
 
     /// Looks a function up by name.
@@ -110,6 +113,7 @@ impl Func {
     pub fn arity(self) -> usize {
         match self {
             Func::Pow | Func::Atan2 | Func::Min | Func::Max => 2,
+            Func::Select => 3,
             _ => 1,
         }
     }

@@ -43,22 +43,13 @@ pub fn grid_params(s: &dyn Surface, o: &GridOptions) -> (Vec<f64>, Vec<f64>) {
 pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     assert!(o.nu >= 2 && o.nv >= 2, "a grid mesh needs at least 2 × 2 vertices");
     let (us, vs) = grid_params(s, o);
-    let rows: Vec<Vec<[Vec3; 4]>> = us
-        .par_iter()
-        .map(|&u| {
-            vs.iter()
-                .map(|&v| {
-                    let d = s.derivatives(u, v, 1, 1);
-                    [d[0], d[2], d[1], d[3]] // p, pu, pv, puv
-                })
-                .collect()
-        })
-        .collect();
+    let flat = s.grid(&us, &vs);
+    let rows: Vec<&[[Vec3; 4]]> = flat.chunks(o.nv).collect();
     let n = o.nu * o.nv;
     let mut positions = Vec::with_capacity(n);
     let mut normals = Vec::with_capacity(n);
     let mut uvs = Vec::with_capacity(n);
-    let mut scales: Vec<f64> = rows.iter().flatten().map(|d| d[1].norm() * d[2].norm()).collect();
+    let mut scales: Vec<f64> = flat.iter().map(|d| d[1].norm() * d[2].norm()).collect();
     scales.sort_by(f64::total_cmp);
     let reference = scales[scales.len() / 2].max(f64::MIN_POSITIVE);
     let dom = s.v_domain();

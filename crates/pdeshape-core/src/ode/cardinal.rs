@@ -126,9 +126,9 @@ mod tests {
         let kmax = l.conditions().iter().map(|c| c.order).max().unwrap();
         for (k, c) in l.conditions().iter().enumerate() {
             let v = l.eval(c.u, kmax);
-            for i in 0..v[0].len() {
+            for (i, x) in v[c.order].iter().enumerate() {
                 let want = if i == k { 1.0 } else { 0.0 };
-                assert!((v[c.order][i] - want).abs() < tol, "ℓ_{i}^({})({}) = {}", c.order, c.u, v[c.order][i]);
+                assert!((x - want).abs() < tol, "ℓ_{i}^({})({}) = {x}", c.order, c.u);
             }
         }
     }

@@ -19,8 +19,10 @@
 
 mod cardinal;
 mod precise;
+mod set;
 mod space;
 
 pub use cardinal::{Cardinal, CondSpec, OdeError};
 pub use precise::ChebCardinal;
+pub use set::{CardinalSet, F64_COND_LIMIT};
 pub use space::{ExpSpace, Root};

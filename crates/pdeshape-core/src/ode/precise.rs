@@ -126,15 +126,15 @@ fn mp_inverse(a: Vec<Vec<BigFloat>>, p: usize) -> Option<Vec<Vec<BigFloat>>> {
         }
         m.swap(col, piv);
         let inv = bf(1.0, p).div(&m[col][col], p, RM);
-        for j in 0..2 * n {
-            m[col][j] = m[col][j].mul(&inv, p, RM);
+        for x in m[col].iter_mut() {
+            *x = x.mul(&inv, p, RM);
         }
-        for r in 0..n {
-            if r != col && !m[r][col].is_zero() {
-                let f = m[r][col].clone();
-                for j in 0..2 * n {
-                    let t = f.mul(&m[col][j], p, RM);
-                    m[r][j] = m[r][j].sub(&t, p, RM);
+        let pivot_row = m[col].clone();
+        for (r, row) in m.iter_mut().enumerate() {
+            if r != col && !row[col].is_zero() {
+                let f = row[col].clone();
+                for (x, q) in row.iter_mut().zip(&pivot_row) {
+                    *x = x.sub(&f.mul(q, p, RM), p, RM);
                 }
             }
         }
@@ -152,6 +152,10 @@ pub struct ChebCardinal {
     dim: usize,
     bits: usize,
     max_inverse: f64,
+    /// Exact (multiple-precision, then rounded) values at the condition points, where the
+    /// cardinal property must hold to round-off for every tabulated derivative order: a
+    /// Chebyshev series of a high derivative is only accurate relative to its maximum.
+    at_conditions: Vec<(f64, Vec<Vec<f64>>)>,
 }
 
 impl ChebCardinal {
@@ -232,13 +236,38 @@ impl ChebCardinal {
                     .collect();
                 coef.push(piece);
             }
-            return Ok(ChebCardinal { breaks, coef, kmax, dim: n, bits, max_inverse: max_inv });
+            let mut at_conditions: Vec<(f64, Vec<Vec<f64>>)> = Vec::new();
+            for cd in conds {
+                if at_conditions.iter().any(|(u, _)| *u == cd.u) {
+                    continue;
+                }
+                let d = mp_derivatives(space, cd.u, kmax, bits, &mut cc);
+                let vals = d
+                    .iter()
+                    .map(|row| {
+                        (0..n)
+                            .map(|i| {
+                                let mut s = bf(0.0, bits);
+                                for (bidx, phi) in row.iter().enumerate() {
+                                    s = s.add(&phi.mul(&inv[bidx][i], bits, RM), bits, RM);
+                                }
+                                to_f64(&s)
+                            })
+                            .collect()
+                    })
+                    .collect();
+                at_conditions.push((cd.u, vals));
+            }
+            return Ok(ChebCardinal { breaks, coef, kmax, dim: n, bits, max_inverse: max_inv, at_conditions });
         }
     }
 
     /// `out[k][i] = ℓ_i^{(k)}(u)`, `k ≤ kmax` (at most the tabulated order).
     pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
         assert!(kmax <= self.kmax, "derivative order {kmax} not tabulated (max {})", self.kmax);
+        if let Some((_, rows)) = self.at_conditions.iter().find(|(c, _)| *c == u) {
+            return rows[..=kmax].to_vec();
+        }
         let pieces = self.breaks.len() - 1;
         let pc = ((u * pieces as f64).floor().max(0.0) as usize).min(pieces - 1);
         let (a, b) = (self.breaks[pc], self.breaks[pc + 1]);

@@ -124,6 +124,7 @@ impl ExpSpace {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // derivative tables are indexed [order][basis]
 mod tests {
     use super::*;
 

@@ -66,6 +66,20 @@ pub trait Surface: Send + Sync {
         self.derivatives(u, v, 0, 0)[0]
     }
 
+    /// Values and first derivatives `[X, X_u, X_v, X_uv]` on the grid `us × vs` (row-major
+    /// in `u`). Solvers override this to share per-row and per-column work.
+    fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
+        use rayon::prelude::*;
+        us.par_iter()
+            .flat_map_iter(|&u| {
+                vs.iter().map(move |&v| {
+                    let d = self.derivatives(u, v, 1, 1);
+                    [d[0], d[2], d[1], d[3]]
+                })
+            })
+            .collect()
+    }
+
     /// `∂ᵏX/∂uᵏ (u, v)`.
     fn u_derivative(&self, u: f64, v: f64, k: usize) -> Vec3 {
         self.derivatives(u, v, k, 0)[k]

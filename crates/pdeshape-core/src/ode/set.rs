@@ -1,0 +1,71 @@
+//! Choosing between f64 and multiple-precision cardinal functions.
+
+use super::{Cardinal, ChebCardinal, CondSpec, ExpSpace, OdeError};
+
+/// Condition number below which the f64 solve is used directly.
+pub const F64_COND_LIMIT: f64 = 1e4;
+
+/// The cardinal functions of a condition set, computed the cheapest exact way: in f64
+/// when the condition matrix is well conditioned (≤ [`F64_COND_LIMIT`]), otherwise in
+/// multiple precision and tabulated.
+#[derive(Clone, Debug)]
+pub enum CardinalSet {
+    /// Solved in f64.
+    Direct(Cardinal),
+    /// Solved in multiple precision, evaluated from f64 Chebyshev series.
+    Tabulated(ChebCardinal),
+}
+
+impl CardinalSet {
+    /// Builds the cardinal functions; `kmax` is the highest derivative that will be
+    /// evaluated (used by the tabulated form).
+    pub fn new(space: ExpSpace, conds: &[CondSpec], kmax: usize) -> Result<Self, OdeError> {
+        let real = space.roots().iter().all(|r| r.im == 0.0);
+        match Cardinal::new(space.clone(), conds) {
+            Ok(c) if c.condition_number() <= F64_COND_LIMIT || !real => Ok(CardinalSet::Direct(c)),
+            Err(e @ (OdeError::Count { .. } | OdeError::Duplicate(..))) => Err(e),
+            Err(e) if !real => Err(e),
+            _ => Ok(CardinalSet::Tabulated(ChebCardinal::new(&space, conds, kmax)?)),
+        }
+    }
+
+    /// `out[k][i] = ℓ_i^{(k)}(u)`.
+    pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
+        match self {
+            CardinalSet::Direct(c) => c.eval(u, kmax),
+            CardinalSet::Tabulated(c) => c.eval(u, kmax),
+        }
+    }
+
+    /// Highest derivative order available (unbounded for the direct form).
+    pub fn kmax(&self) -> usize {
+        match self {
+            CardinalSet::Direct(_) => usize::MAX,
+            CardinalSet::Tabulated(c) => c.kmax(),
+        }
+    }
+
+    /// The condition number of the f64 condition matrix, or the size of the inverse
+    /// computed in multiple precision (a lower bound of the condition number).
+    pub fn condition_number(&self) -> f64 {
+        match self {
+            CardinalSet::Direct(c) => c.condition_number(),
+            CardinalSet::Tabulated(c) => c.max_inverse(),
+        }
+    }
+
+    /// Which method ran.
+    pub fn method(&self) -> &'static str {
+        match self {
+            CardinalSet::Direct(_) => "f64",
+            CardinalSet::Tabulated(_) => "multiprecision",
+        }
+    }
+
+    /// `max_u Σ_i |ℓ_i(u)|` on `samples + 1` equispaced points.
+    pub fn lebesgue(&self, samples: usize) -> f64 {
+        (0..=samples)
+            .map(|k| self.eval(k as f64 / samples as f64, 0)[0].iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    }
+}

@@ -1,0 +1,369 @@
+//! PDE surfaces of any even order 2N (SPEC §3; papers 004 and 003).
+//!
+//! The patch solves `(∂u² + a²∂θ²)^N X = 0` on `[0, 1] × [0, 2π)` with `2N` conditions
+//! `∂^{d_i}X/∂u^{d_i}(u_i, θ) = g_i(θ)`. With the Fourier series of the data,
+//!
+//! ```text
+//! X̃(u, θ) = A₀(u) + Σ_{n=1}^{M} [A_n(u) cos nθ + B_n(u) sin nθ],
+//! A_n(u) = Σ_i ℓ_i^{(n)}(u) a_{i,n},  B_n(u) = Σ_i ℓ_i^{(n)}(u) b_{i,n},
+//! ```
+//!
+//! where `ℓ^{(n)}` are the cardinal functions of the condition set in `ker (D² − a²n²)^N`
+//! (polynomials of degree `2N − 1` for `n = 0`), see [`crate::ode`]. `X̃` solves the PDE
+//! exactly and meets the conditions up to the truncated Fourier tail
+//! `r_i(θ) = g_i(θ) − F_M[g_i](θ)`. The remainder
+//!
+//! ```text
+//! R(u, θ) = Σ_i ℓ_i^{(ω)}(u) r_i(θ),   ℓ^{(ω)} cardinal in ker (D² − ω²)^N,  ω = a (M + 1),
+//! ```
+//!
+//! has `∂^{d_k}R/∂u^{d_k}(u_k, θ) = r_k(θ)`, so `X = X̃ + R` meets **every** condition
+//! exactly at every θ (paper 004 eqs. 23/25, whose printed `r_1`, `r_{2N}` have typos).
+//!
+//! Open patches (`v ∈ [v₀, v₁]`) are solved on the even extension (SPEC §2): θ = π(v − v₀)/(v₁ − v₀),
+//! and `a` is the shape parameter in θ.
+
+use crate::Vec3;
+use crate::data::fourier::{FourierSeries, sample_count};
+use crate::data::{EvenExtension, FieldRef};
+use crate::jet::JetShape;
+use crate::ode::{CardinalSet, CondSpec, ExpSpace, OdeError};
+use crate::patch::{Condition, Surface, VDomain};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
+
+/// Options of the spectral solver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpectralOptions {
+    /// The shape parameter `a` (> 0): larger `a` shortens the reach of the boundary data.
+    pub a: f64,
+    /// Fourier modes kept, `M` (default 6).
+    pub modes: usize,
+    /// Remainder rate `ω` (default `a (M + 1)`).
+    pub omega: Option<f64>,
+}
+
+impl Default for SpectralOptions {
+    fn default() -> Self {
+        SpectralOptions { a: 1.0, modes: 6, omega: None }
+    }
+}
+
+/// Why a spectral patch cannot be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SpectralError {
+    /// Bad options.
+    #[error("{0}")]
+    Options(String),
+    /// The conditions do not determine the solution.
+    #[error("mode {mode} ({what}): {source}")]
+    Conditions {
+        /// Fourier mode (or `ω` for the remainder).
+        mode: String,
+        /// Description of the condition set.
+        what: String,
+        /// The underlying failure.
+        source: OdeError,
+    },
+}
+
+/// Per-row cache: `a[k][n] = A_n^{(k)}(u)`, `b[k][n]`, `l[k][i] = ℓ_i^{(ω,k)}(u)`.
+struct Row {
+    a: Vec<Vec<Vec3>>,
+    b: Vec<Vec<Vec3>>,
+    l: Vec<Vec<f64>>,
+}
+
+/// A PDE surface of order `2N` solved by Fourier modes plus the exactness remainder.
+pub struct SpectralPatch {
+    domain: VDomain,
+    dtheta_dv: f64,
+    n: usize,
+    opts: SpectralOptions,
+    omega: f64,
+    conds: Vec<CondSpec>,
+    data: Vec<FieldRef>,
+    series: Vec<FourierSeries>,
+    cards: Vec<CardinalSet>,
+    rem: CardinalSet,
+    time: f64,
+    cache: Mutex<HashMap<(u64, usize), Arc<Row>>>,
+}
+
+impl std::fmt::Debug for SpectralPatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SpectralPatch").field("order", &(2 * self.n)).field("opts", &self.opts).finish()
+    }
+}
+
+/// Diagnostics of a solved spectral patch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectralReport {
+    /// PDE order `2N`.
+    pub order: usize,
+    /// Modes `M`.
+    pub modes: usize,
+    /// Remainder rate.
+    pub omega: f64,
+    /// Largest condition number over the mode systems (f64 solve) or inverse size
+    /// (multiple precision).
+    pub max_mode_condition: f64,
+    /// How the cardinal functions were computed: counts of `f64` and `multiprecision` modes.
+    pub methods: (usize, usize),
+    /// Lebesgue constants of the condition set for mode 0 and mode 1 (amplification of
+    /// the data between the conditions).
+    pub lebesgue: (f64, Option<f64>),
+}
+
+fn describe(conds: &[CondSpec]) -> String {
+    conds.iter().map(|c| format!("∂^{} at u = {}", c.order, c.u)).collect::<Vec<_>>().join(", ")
+}
+
+impl SpectralPatch {
+    /// Solves the patch for `conds` (data slots `(v, t)`) over `domain` at time `t`.
+    pub fn new(conds: &[Condition], domain: VDomain, opts: SpectralOptions) -> Result<Self, SpectralError> {
+        if conds.len() < 2 || !conds.len().is_multiple_of(2) {
+            return Err(SpectralError::Options(format!(
+                "a PDE of order 2N needs 2N conditions (an even number ≥ 2); got {}",
+                conds.len()
+            )));
+        }
+        if !(opts.a.is_finite() && opts.a > 0.0) {
+            return Err(SpectralError::Options(format!("the shape parameter a = {} must be positive", opts.a)));
+        }
+        if opts.modes > 512 {
+            return Err(SpectralError::Options(format!("{} Fourier modes exceed the limit of 512", opts.modes)));
+        }
+        let n = conds.len() / 2;
+        let omega = opts.omega.unwrap_or(opts.a * (opts.modes + 1) as f64);
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(SpectralError::Options(format!("the remainder rate ω = {omega} must be positive")));
+        }
+        let specs: Vec<CondSpec> = conds.iter().map(|c| CondSpec { u: c.u, order: c.order }).collect();
+        let dmax = specs.iter().map(|c| c.order).max().unwrap_or(0);
+        // Tabulate what evaluation needs (normals, curvature, conditions) and, where it is
+        // affordable, the 2N-th derivatives for the PDE residual.
+        let kmax = dmax.max(2).max(if n <= 10 { 2 * n } else { 0 });
+        let (data, dtheta_dv): (Vec<FieldRef>, f64) = if domain.periodic {
+            (conds.iter().map(|c| c.data.clone()).collect(), 1.0)
+        } else {
+            (
+                conds
+                    .iter()
+                    .map(|c| Arc::new(EvenExtension::new(c.data.clone(), domain.start, domain.end)) as FieldRef)
+                    .collect(),
+                PI / (domain.end - domain.start),
+            )
+        };
+        let samples = sample_count(opts.modes);
+        let series: Vec<FourierSeries> =
+            data.par_iter().map(|g| FourierSeries::analyse(|th| g.eval(&[th, 0.0]), opts.modes, samples)).collect();
+        let what = describe(&specs);
+        let cards: Vec<CardinalSet> = (0..=opts.modes)
+            .into_par_iter()
+            .map(|m| {
+                CardinalSet::new(ExpSpace::symmetric(opts.a * m as f64, n), &specs, kmax)
+                    .map_err(|source| SpectralError::Conditions { mode: m.to_string(), what: what.clone(), source })
+            })
+            .collect::<Result<_, _>>()?;
+        let rem = CardinalSet::new(ExpSpace::symmetric(omega, n), &specs, kmax.max(2 * n))
+            .map_err(|source| SpectralError::Conditions { mode: format!("ω = {omega}"), what, source })?;
+        Ok(SpectralPatch {
+            domain,
+            dtheta_dv,
+            n,
+            opts,
+            omega,
+            conds: specs,
+            data,
+            series,
+            cards,
+            rem,
+            time: 0.0,
+            cache: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// PDE order `2N`.
+    pub fn order(&self) -> usize {
+        2 * self.n
+    }
+
+    /// The options in force (with `ω` resolved).
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// Diagnostics.
+    pub fn report(&self) -> SpectralReport {
+        let max_mode_condition = self.cards.iter().map(|c| c.condition_number()).fold(0.0, f64::max);
+        let mp = self.cards.iter().filter(|c| matches!(c, CardinalSet::Tabulated(_))).count();
+        SpectralReport {
+            order: 2 * self.n,
+            modes: self.opts.modes,
+            omega: self.omega,
+            max_mode_condition,
+            methods: (self.cards.len() - mp, mp),
+            lebesgue: (self.cards[0].lebesgue(400), self.cards.get(1).map(|c| c.lebesgue(400))),
+        }
+    }
+
+    fn theta(&self, v: f64) -> f64 {
+        if self.domain.periodic { v } else { (v - self.domain.start) * self.dtheta_dv }
+    }
+
+    fn row(&self, u: f64, k: usize) -> Arc<Row> {
+        let key = (u.to_bits(), k);
+        if let Some(r) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return r;
+        }
+        let m = self.opts.modes;
+        let mut a = vec![vec![Vec3::ZERO; m + 1]; k + 1];
+        let mut b = vec![vec![Vec3::ZERO; m + 1]; k + 1];
+        for (mode, card) in self.cards.iter().enumerate() {
+            let l = card.eval(u, k);
+            for (kk, lk) in l.iter().enumerate() {
+                for (i, s) in self.series.iter().enumerate() {
+                    a[kk][mode] += s.a[mode] * lk[i];
+                    b[kk][mode] += s.b[mode] * lk[i];
+                }
+            }
+        }
+        let row = Arc::new(Row { a, b, l: self.rem.eval(u, k) });
+        if let Ok(mut c) = self.cache.lock() {
+            if c.len() > 4096 {
+                c.clear();
+            }
+            c.insert(key, row.clone());
+        }
+        row
+    }
+
+    /// `r_i^{(j)}(θ)` for every condition, `j = 0 … jmax` (θ-derivatives).
+    fn tails(&self, theta: f64, jmax: usize) -> Vec<Vec<Vec3>> {
+        let shape = JetShape::new(&[jmax]);
+        self.data
+            .iter()
+            .zip(&self.series)
+            .map(|(g, s)| {
+                let jet = g.jet(&[theta, self.time], shape);
+                (0..=jmax).map(|j| jet.derivative([j, 0, 0]) - s.eval_derivative(theta, j)).collect()
+            })
+            .collect()
+    }
+
+    /// `∂^{i+j}X/∂uⁱ∂θʲ` at one point, from a cached row and the tails at θ.
+    fn combine(&self, row: &Row, tails: &[Vec<Vec3>], theta: f64, i: usize, j: usize) -> Vec3 {
+        let mut s = Vec3::ZERO;
+        for n in 0..=self.opts.modes {
+            let nf = n as f64;
+            if n == 0 {
+                if j == 0 {
+                    s += row.a[i][0];
+                }
+                continue;
+            }
+            let ph = nf * theta + j as f64 * PI / 2.0;
+            let f = nf.powi(j as i32);
+            let (sn, cs) = ph.sin_cos();
+            s += (row.a[i][n] * cs + row.b[i][n] * sn) * f;
+        }
+        for (c, t) in tails.iter().enumerate() {
+            s += t[j] * row.l[i][c];
+        }
+        s
+    }
+
+    /// The PDE residual `(∂u² + a²∂θ²)^N` at `(u, v)` of the truncated solution `X̃`, of the
+    /// remainder `R` and of the whole `X` (norms of the vector residuals). The truncated
+    /// part needs the `2N`-th derivatives of every mode's cardinal functions, which are
+    /// tabulated only for `N ≤ 10`; above that it is `None` (not computed, not assumed).
+    pub fn residual(&self, u: f64, v: f64) -> Residual {
+        let n = self.n;
+        let k = 2 * n;
+        let theta = self.theta(v);
+        let binom = |n: usize, k: usize| (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64);
+        let a2 = self.opts.a * self.opts.a;
+        let trunc = self.cards.iter().all(|c| c.kmax() >= k).then(|| {
+            let row = self.row(u, k);
+            let zero_tails: Vec<Vec<Vec3>> = vec![vec![Vec3::ZERO; k + 1]; self.conds.len()];
+            let mut r = Vec3::ZERO;
+            for q in 0..=n {
+                let w = binom(n, q) * a2.powi((n - q) as i32);
+                r += self.combine(&row, &zero_tails, theta, 2 * q, 2 * (n - q)) * w;
+            }
+            r
+        });
+        let l = self.rem.eval(u, k);
+        let tails = self.tails(theta, k);
+        let mut rem = Vec3::ZERO;
+        for q in 0..=n {
+            let w = binom(n, q) * a2.powi((n - q) as i32);
+            for (c, t) in tails.iter().enumerate() {
+                rem += t[2 * (n - q)] * (l[2 * q][c] * w);
+            }
+        }
+        Residual { truncated: trunc.map(|t| t.norm()), remainder: rem.norm(), whole: trunc.map(|t| (t + rem).norm()) }
+    }
+}
+
+/// PDE residual norms at a point (see [`SpectralPatch::residual`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Residual {
+    /// Of the truncated Fourier solution (zero up to round-off by construction).
+    pub truncated: Option<f64>,
+    /// Of the remainder term.
+    pub remainder: f64,
+    /// Of the whole patch.
+    pub whole: Option<f64>,
+}
+
+impl Surface for SpectralPatch {
+    fn v_domain(&self) -> VDomain {
+        self.domain
+    }
+
+    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+        let theta = self.theta(v);
+        let row = self.row(u, du);
+        let tails = self.tails(theta, dv);
+        let mut out = Vec::with_capacity((du + 1) * (dv + 1));
+        for i in 0..=du {
+            for j in 0..=dv {
+                out.push(self.combine(&row, &tails, theta, i, j) * self.dtheta_dv.powi(j as i32));
+            }
+        }
+        out
+    }
+
+    fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
+        let cols: Vec<(f64, Vec<Vec<Vec3>>)> = vs
+            .par_iter()
+            .map(|&v| {
+                let th = self.theta(v);
+                (th, self.tails(th, 1))
+            })
+            .collect();
+        let s = self.dtheta_dv;
+        us.par_iter()
+            .flat_map_iter(|&u| {
+                let row = self.row(u, 1);
+                cols.iter()
+                    .map(|(th, tails)| {
+                        [
+                            self.combine(&row, tails, *th, 0, 0),
+                            self.combine(&row, tails, *th, 1, 0),
+                            self.combine(&row, tails, *th, 0, 1) * s,
+                            self.combine(&row, tails, *th, 1, 1) * s,
+                        ]
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests;
