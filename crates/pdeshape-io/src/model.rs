@@ -68,14 +68,21 @@ pub fn render_scene(scene: &Scene) -> Result<Image, String> {
     Ok(render_meshes(&patches, &context, &colors, &scene.render))
 }
 
+/// Lebesgue constant above which `check` warns that the condition set amplifies its data
+/// (SPEC §3 "Many sections").
+pub const LEBESGUE_WARNING: f64 = 1e3;
+
 /// Diagnostics of one patch, as `check --json` prints them.
 pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     let rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
     let dom = p.surface.v_domain();
-    json!({
+    let mut d = json!({
         "name": p.name,
         "kind": p.kind.name(),
-        "solver": match p.kind { crate::scene::PatchKind::Hermite => "hermite-interpolation" },
+        "solver": match p.kind {
+            crate::scene::PatchKind::Hermite => "hermite-interpolation",
+            crate::scene::PatchKind::Pde => "spectral",
+        },
         "conditions": p.conditions.iter().map(|c| json!({"u": c.u, "order": c.order})).collect::<Vec<_>>(),
         "v_domain": {"start": dom.start, "end": dom.end, "periodic": dom.periodic},
         "resolution": [p.resolution.0, p.resolution.1],
@@ -85,7 +92,52 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             "max_rel": rep.max_rel,
             "patch_size": rep.size,
         },
-    })
+        "warnings": [],
+    });
+    if let Some(sp) = &p.spectral {
+        let r = sp.report();
+        // RMS residuals on an interior grid
+        let (mut t2, mut w2, mut r2, mut n, mut have_t) = (0.0, 0.0, 0.0, 0.0, true);
+        for i in 1..12 {
+            for j in 0..24 {
+                let v = dom.at((j as f64 + 0.5) / 24.0);
+                let res = sp.residual(i as f64 / 12.0, v);
+                r2 += res.remainder * res.remainder;
+                match (res.truncated, res.whole) {
+                    (Some(t), Some(w)) => {
+                        t2 += t * t;
+                        w2 += w * w;
+                    }
+                    _ => have_t = false,
+                }
+                n += 1.0;
+            }
+        }
+        d["spectral"] = json!({
+            "order": r.order,
+            "modes": r.modes,
+            "omega": r.omega,
+            "max_mode_condition_number": r.max_mode_condition,
+            "modes_solved_in_f64": r.methods.0,
+            "modes_solved_in_multiprecision": r.methods.1,
+            "lebesgue_mode0": r.lebesgue.0,
+            "lebesgue_mode1": r.lebesgue.1,
+            "rms_residual_truncated": if have_t { json!((t2 / n).sqrt()) } else { Value::Null },
+            "rms_residual_remainder": (r2 / n).sqrt(),
+            "rms_residual_whole": if have_t { json!((w2 / n).sqrt()) } else { Value::Null },
+        });
+        let leb = r.lebesgue.0.max(r.lebesgue.1.unwrap_or(0.0));
+        if leb > LEBESGUE_WARNING {
+            d["warnings"].as_array_mut().map(|w| {
+                w.push(json!(format!(
+                    "the condition set amplifies its data by up to {leb:.3e} between conditions (Lebesgue constant): \
+                     many sections at equispaced u make high-order interpolation swing; place them at \
+                     Chebyshev-distributed u (sections.spacing = \"chebyshev\") or use fewer sections"
+                )))
+            });
+        }
+    }
+    d
 }
 
 /// Diagnostics of a scene.

@@ -8,6 +8,7 @@ use pdeshape_core::Vec3;
 use pdeshape_core::data::{BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative};
 use pdeshape_core::expr::{BinOp, Expr, ExprError, Func, Node};
 use pdeshape_core::patch::{Condition, HermitePatch, VDomain};
+use pdeshape_core::spectral::{SpectralOptions, SpectralPatch};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::Arc;
@@ -650,28 +651,46 @@ fn build_patch(
     let rp = p.get_ref();
     let kind = match rp.kind.get_ref().as_str() {
         "hermite" => PatchKind::Hermite,
-        k @ ("pde" | "blend" | "dynamic" | "solid") => {
+        "pde" => PatchKind::Pde,
+        k @ ("blend" | "dynamic" | "solid") => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("patch kind `{k}` is not available in this version of pdeshape (available: hermite)"),
+                format!("patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde)"),
             ));
         }
         k => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("unknown patch kind `{k}` (known: hermite)"),
+                format!("unknown patch kind `{k}` (known: hermite, pde)"),
             ));
         }
     };
+    if kind != PatchKind::Pde {
+        for (present, name) in [(rp.a.is_some(), "a"), (rp.modes.is_some(), "modes"), (rp.omega.is_some(), "omega")] {
+            if present {
+                return Err(ctx.err(
+                    span(p),
+                    format!("{key}.{name}"),
+                    format!("`{name}` only applies to kind = \"pde\""),
+                ));
+            }
+        }
+    }
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;
-    let Some(rconds) = &rp.conditions else {
-        return Err(ctx.err(span(p), &key, "the patch has no `conditions`"));
-    };
+    if rp.conditions.is_none() && rp.sections.is_none() {
+        return Err(ctx.err(span(p), &key, "the patch has no `conditions` (and no `sections`)"));
+    }
+    let no_conds = Vec::new();
+    let rconds_list = rp.conditions.as_ref().map(|c| c.get_ref()).unwrap_or(&no_conds);
+    let conds_span = rp.conditions.as_ref().map(|c| c.span()).or(Some(p.span()));
     let mut conditions = Vec::new();
-    for (i, rc) in rconds.get_ref().iter().enumerate() {
+    if let Some(sec) = &rp.sections {
+        conditions.extend(build_sections(ctx, sec, domain, &format!("{key}.sections"))?);
+    }
+    for (i, rc) in rconds_list.iter().enumerate() {
         let ck = format!("{key}.conditions[{i}]");
         let c = rc.get_ref();
         let u = ctx.num(c.u.get_ref(), span(&c.u), &format!("{ck}.u"))?;
@@ -728,12 +747,125 @@ fn build_patch(
         check_data(ctx, &data, domain, span(rc), &ck)?;
         conditions.push(Condition { u, order, data });
     }
-    let surface = match kind {
-        PatchKind::Hermite => HermitePatch::new(&conditions, domain)
-            .map_err(|e| ctx.err(span(rconds), format!("{key}.conditions"), e.to_string()))?,
+    let mut spectral = None;
+    let surface: Arc<dyn pdeshape_core::patch::Surface> = match kind {
+        PatchKind::Hermite => Arc::new(
+            HermitePatch::new(&conditions, domain)
+                .map_err(|e| ctx.err(conds_span.clone(), format!("{key}.conditions"), e.to_string()))?,
+        ),
+        PatchKind::Pde => {
+            let a = match &rp.a {
+                Some(x) => ctx.num(x.get_ref(), span(x), &format!("{key}.a"))?,
+                None => 1.0,
+            };
+            let modes = match &rp.modes {
+                Some(m) => ctx.int(m, 0, 512, &format!("{key}.modes"))? as usize,
+                None => 6,
+            };
+            let omega =
+                rp.omega.as_ref().map(|x| ctx.num(x.get_ref(), span(x), &format!("{key}.omega"))).transpose()?;
+            let sp = SpectralPatch::new(&conditions, domain, SpectralOptions { a, modes, omega })
+                .map_err(|e| ctx.err(conds_span.clone(), format!("{key}.conditions"), e.to_string()))?;
+            let sp = Arc::new(sp);
+            spectral = Some(sp.clone());
+            sp
+        }
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    Ok(ScenePatch { name: pname.to_string(), kind, surface: Arc::new(surface), conditions, resolution, color })
+    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral })
+}
+
+/// Expands `[patches.NAME.sections]` into position conditions.
+fn build_sections(ctx: &Ctx, sec: &Spanned<RawSections>, domain: VDomain, key: &str) -> R<Vec<Condition>> {
+    let rs = sec.get_ref();
+    let count = ctx.int(&rs.count, 2, 200, &format!("{key}.count"))? as usize;
+    let us: Vec<f64> = match (&rs.u, &rs.spacing) {
+        (Some(_), Some(sp)) => {
+            return Err(ctx.err(span(sp), format!("{key}.spacing"), "give either `spacing` or explicit `u`, not both"));
+        }
+        (Some(list), None) => {
+            if list.get_ref().len() != count {
+                return Err(ctx.err(
+                    span(list),
+                    format!("{key}.u"),
+                    format!("{} values for {count} sections", list.get_ref().len()),
+                ));
+            }
+            for &u in list.get_ref() {
+                if !(0.0..=1.0).contains(&u) {
+                    return Err(ctx.err(span(list), format!("{key}.u"), format!("u = {u} is outside [0, 1]")));
+                }
+            }
+            list.get_ref().clone()
+        }
+        (None, sp) => {
+            let word = sp.as_ref().map(|s| s.get_ref().as_str()).unwrap_or("chebyshev");
+            let m = (count - 1) as f64;
+            match word {
+                "uniform" => (0..count).map(|i| i as f64 / m).collect(),
+                "chebyshev" => (0..count).map(|i| (1.0 - (std::f64::consts::PI * i as f64 / m).cos()) / 2.0).collect(),
+                w => {
+                    return Err(ctx.err(
+                        sp.as_ref().and_then(span),
+                        format!("{key}.spacing"),
+                        format!("unknown spacing `{w}` (expected \"uniform\", \"chebyshev\" or explicit u = [...])"),
+                    ));
+                }
+            }
+        }
+    };
+    let s_text = rs.s.as_ref().map(|s| s.get_ref().clone()).unwrap_or_else(|| "i".into());
+    let s_span = rs.s.as_ref().and_then(span);
+    let s_expr = Expr::parse(&s_text).map_err(|e| ctx.expr_err(s_span.clone(), format!("{key}.s"), &s_text, &e))?;
+    let texts: Vec<String> = rs
+        .expr
+        .get_ref()
+        .iter()
+        .map(|c| match c {
+            NumOrExpr::Num(v) => format!("{v:?}"),
+            NumOrExpr::Expr(s) => s.clone(),
+        })
+        .collect();
+    let parsed: Vec<Expr> = texts
+        .iter()
+        .enumerate()
+        .map(|(k, t)| Expr::parse(t).map_err(|e| ctx.expr_err(span(&rs.expr), format!("{key}.expr[{k}]"), t, &e)))
+        .collect::<R<_>>()?;
+    let mut out = Vec::with_capacity(count);
+    for (i, &u) in us.iter().enumerate() {
+        let idx = i as f64;
+        let lookup_i = |n: &str| {
+            if n == "i" {
+                Some(idx)
+            } else if n == "count" {
+                Some(count as f64)
+            } else {
+                ctx.params.get(n).map(|p| p.value)
+            }
+        };
+        let s_i = s_expr
+            .bind(&[], &lookup_i)
+            .map_err(|e| ctx.expr_err(s_span.clone(), format!("{key}.s"), &s_text, &e))?
+            .eval(&[]);
+        if !s_i.is_finite() {
+            return Err(ctx.err(s_span.clone(), format!("{key}.s"), format!("s is not finite for section {i}")));
+        }
+        let lookup = |n: &str| if n == "s" { Some(s_i) } else { lookup_i(n) };
+        let comps: Vec<Expr> = parsed
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                e.bind(&["v", "t"], &lookup)
+                    .map_err(|er| ctx.expr_err(span(&rs.expr), format!("{key}.expr[{k}]"), &texts[k], &er))
+            })
+            .collect::<R<_>>()?;
+        let comps: [Expr; 3] =
+            comps.try_into().map_err(|_| ctx.err(span(&rs.expr), key, "three components expected"))?;
+        let data: FieldRef = Arc::new(ExprField::from_exprs(comps, &["v", "t"]));
+        check_data(ctx, &data, domain, span(sec), &format!("{key} (section {i}, s = {s_i})"))?;
+        out.push(Condition { u, order: 0, data });
+    }
+    Ok(out)
 }
 
 /// Checks that condition data are finite on the domain and, for a periodic patch, closed.

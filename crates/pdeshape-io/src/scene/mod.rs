@@ -18,6 +18,7 @@ pub use error::{SceneError, Source};
 use indexmap::IndexMap;
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::patch::{Condition, Surface, VDomain};
+use pdeshape_core::spectral::SpectralPatch;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -59,6 +60,8 @@ pub struct SceneSurface {
 pub enum PatchKind {
     /// Ruled/Hermite interpolation in `u` (no PDE).
     Hermite,
+    /// `(∂u² + a²∂v²)^N X = 0` by the spectral method (SPEC §3).
+    Pde,
 }
 
 impl PatchKind {
@@ -66,6 +69,7 @@ impl PatchKind {
     pub fn name(self) -> &'static str {
         match self {
             PatchKind::Hermite => "hermite",
+            PatchKind::Pde => "pde",
         }
     }
 }
@@ -85,6 +89,8 @@ pub struct ScenePatch {
     pub resolution: (usize, usize),
     /// Display colour.
     pub color: Option<[f64; 3]>,
+    /// The spectral solution, for PDE patches (diagnostics).
+    pub spectral: Option<Arc<SpectralPatch>>,
 }
 
 impl std::fmt::Debug for ScenePatch {

@@ -119,6 +119,29 @@ pub struct RawPatch {
     pub conditions: Option<Spanned<Vec<Spanned<RawCondition>>>>,
     /// Display colour `[r, g, b]` in 0…1.
     pub color: Option<Spanned<[f64; 3]>>,
+    /// PDE patches: the shape parameter `a`.
+    pub a: Option<Spanned<NumOrExpr>>,
+    /// PDE patches: Fourier modes `M`.
+    pub modes: Option<Spanned<i64>>,
+    /// PDE patches: remainder rate `ω` (default `a (M + 1)`).
+    pub omega: Option<Spanned<NumOrExpr>>,
+    /// A family of position conditions (cross sections).
+    pub sections: Option<Spanned<RawSections>>,
+}
+
+/// `[patches.NAME.sections]`: `count` position conditions `X(u_i, v) = C(v; s_i)`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSections {
+    pub count: Spanned<i64>,
+    /// `"uniform"` (u_i = i/(count−1)) or `"chebyshev"` (u_i = (1 − cos(π i/(count−1)))/2).
+    pub spacing: Option<Spanned<String>>,
+    /// Explicit u_i instead of a spacing.
+    pub u: Option<Spanned<Vec<f64>>>,
+    /// The section parameter `s_i` as an expression in the index `i` (default `i`).
+    pub s: Option<Spanned<String>>,
+    /// The section curve: three expressions in `v`, `s` (and `i`, `t`).
+    pub expr: Spanned<[NumOrExpr; 3]>,
 }
 
 /// `[render]`: the picture.
