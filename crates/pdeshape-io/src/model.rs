@@ -94,6 +94,21 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         },
         "warnings": [],
     });
+    if let Some(fam) = &p.sections {
+        // How far the patch strays from the section family between its sections.
+        let mut worst: f64 = 0.0;
+        for i in 0..=400 {
+            let u = i as f64 / 400.0;
+            let s = fam.s_at(u);
+            for j in 0..48 {
+                let v = dom.at((j as f64 + 0.25) / 48.0);
+                let x = p.surface.point(u, v);
+                let r = pdeshape_core::data::Field::eval(fam.curve.as_ref(), &[v, 0.0, s]);
+                worst = worst.max((x - r).norm());
+            }
+        }
+        d["section_reference_distance"] = json!(worst);
+    }
     if let Some(sp) = &p.spectral {
         let r = sp.report();
         // The 2N-th derivatives behind the residual are evaluated in f64; above N = 10 their
@@ -105,7 +120,7 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             for j in 0..24 {
                 let v = dom.at((j as f64 + 0.5) / 24.0);
                 let res = sp.residual(i as f64 / 12.0, v);
-                r2 += res.remainder * res.remainder;
+                r2 += res.remainder.unwrap_or(f64::NAN).powi(2);
                 match (res.truncated, res.whole) {
                     (Some(t), Some(w)) => {
                         t2 += t * t;
@@ -142,6 +157,57 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         }
     }
     d
+}
+
+/// The convergence study of a PDE patch over an interior grid for `M = 1 … 16` modes
+/// (ω = a (M + 1)), as a plot: max and RMS PDE residual of the whole patch, and the size of
+/// the remainder. For data whose derivatives of order 2N are not continuous (polylines,
+/// B-splines) the pointwise residual of the remainder grows with M — it contains the
+/// 2N-th derivative of a Fourier tail — while the remainder itself shrinks. `None` for other
+/// patches and for orders above 8 (where the study would be slow to compute).
+pub fn convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
+    use pdeshape_core::spectral::{SpectralOptions, SpectralPatch};
+    let sp = p.spectral.as_ref()?;
+    if sp.order() > 8 {
+        return None;
+    }
+    let dom = p.surface.v_domain();
+    let a = sp.options().a;
+    let (mut max_pts, mut rms_pts, mut rem_pts) = (Vec::new(), Vec::new(), Vec::new());
+    for m in 1..=16usize {
+        let Ok(q) = SpectralPatch::new(&p.conditions, dom, SpectralOptions { a, modes: m, omega: None }) else {
+            continue;
+        };
+        let (mut mx, mut s2, mut n, mut rem) = (0.0f64, 0.0, 0.0, 0.0f64);
+        for i in 1..16 {
+            for j in 0..32 {
+                let (u, v) = (i as f64 / 16.0, dom.at((j as f64 + 0.5) / 32.0));
+                rem = rem.max(q.remainder(u, v).norm());
+                if let Some(r) = q.residual(u, v).whole {
+                    mx = mx.max(r);
+                    s2 += r * r;
+                    n += 1.0;
+                }
+            }
+        }
+        rem_pts.push((m as f64, rem));
+        if n > 0.0 {
+            max_pts.push((m as f64, mx));
+            rms_pts.push((m as f64, (s2 / n).sqrt()));
+        }
+    }
+    Some(crate::render::line_plot(
+        &format!("{}: convergence in the number of Fourier modes", p.name),
+        "modes M",
+        "size",
+        &[
+            crate::render::Series { label: "max PDE residual".into(), points: max_pts },
+            crate::render::Series { label: "RMS PDE residual".into(), points: rms_pts },
+            crate::render::Series { label: "max |remainder R|".into(), points: rem_pts },
+        ],
+        true,
+        (640, 420),
+    ))
 }
 
 /// Diagnostics of a scene.

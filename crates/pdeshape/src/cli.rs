@@ -236,6 +236,25 @@ fn execute(cli: Cli) -> Result<()> {
                         p["condition_error"]["max_abs"].as_f64().unwrap_or(f64::NAN),
                         p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN),
                     );
+                    let sp = &p["spectral"];
+                    if sp.is_object() {
+                        println!(
+                            "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}",
+                            sp["order"],
+                            sp["modes"],
+                            sp["omega"],
+                            sp["max_mode_condition_number"].as_f64().unwrap_or(f64::NAN),
+                            sp["modes_solved_in_f64"],
+                            sp["modes_solved_in_multiprecision"],
+                            sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
+                        );
+                    }
+                    if let Some(x) = p["section_reference_distance"].as_f64() {
+                        println!("      max distance to the section family at interpolated s: {x:.4}");
+                    }
+                    for w in p["warnings"].as_array().into_iter().flatten() {
+                        println!("      warning: {}", w.as_str().unwrap_or(""));
+                    }
                 }
             }
             Ok(())

@@ -15,6 +15,7 @@ struct Entry {
     description: String,
     reference: String,
     picture: Option<String>,
+    plots: Vec<String>,
     files: Vec<String>,
     diagnostics: String,
     error: Option<String>,
@@ -31,6 +32,7 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         description: String::new(),
         reference: String::new(),
         picture: None,
+        plots: Vec::new(),
         files: Vec::new(),
         diagnostics: String::new(),
         error: None,
@@ -61,6 +63,20 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         Err(err) => {
             e.error = Some(format!("{err:#}"));
             return e;
+        }
+    }
+    for p in &scene.patches {
+        if let Some(plot) = model::convergence_plot(p) {
+            match plot {
+                Ok(img) => {
+                    let rel = format!("{name}/{name}-{}-convergence.png", p.name);
+                    let path = dir.join(&rel);
+                    if pdeshape_io::export::write_atomic(&path, |w| img.write_png(w)).is_ok() {
+                        e.plots.push(rel);
+                    }
+                }
+                Err(err) => e.error = Some(err),
+            }
         }
     }
     let d = model::scene_diagnostics(&scene);
@@ -116,6 +132,9 @@ pub fn run(dir: &Path, quiet: bool) -> Result<()> {
         let _ = write!(html, "</p><p>{}</p>", esc(&e.description));
         if let Some(p) = &e.picture {
             let _ = write!(html, "<img src=\"{}\" alt=\"{}\">", esc(p), esc(&e.title));
+        }
+        for p in &e.plots {
+            let _ = write!(html, "<img class=\"plot\" src=\"{}\" alt=\"convergence\">", esc(p));
         }
         if let Some(err) = &e.error {
             let _ = write!(html, "<p class=\"err\">{}</p>", esc(err));

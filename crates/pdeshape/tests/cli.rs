@@ -123,8 +123,9 @@ fn gallery_builds_an_index_with_pictures() {
         .unwrap()
         .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "toml"))
         .count();
-    assert_eq!(html.matches("<img ").count(), n_examples);
-    for img in html.split("<img src=\"").skip(1) {
+    assert_eq!(html.matches("<img src").count(), n_examples, "one picture per example");
+    assert!(html.contains("four-curve-patch-sheet-convergence.png"), "the convergence plot of the four-curve patch");
+    for img in html.split(" src=\"").skip(1) {
         let path = img.split('"').next().unwrap();
         let bytes = std::fs::read(dir.path().join(path)).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");

@@ -168,7 +168,7 @@ impl SpectralPatch {
                     .map_err(|source| SpectralError::Conditions { mode: m.to_string(), what: what.clone(), source })
             })
             .collect::<Result<_, _>>()?;
-        let rem = CardinalSet::new(ExpSpace::symmetric(omega, n), &specs, kmax.max(2 * n))
+        let rem = CardinalSet::new(ExpSpace::symmetric(omega, n), &specs, kmax)
             .map_err(|source| SpectralError::Conditions { mode: format!("ω = {omega}"), what, source })?;
         Ok(SpectralPatch {
             domain,
@@ -191,7 +191,12 @@ impl SpectralPatch {
         2 * self.n
     }
 
-    /// The options in force (with `ω` resolved).
+    /// The options it was solved with.
+    pub fn options(&self) -> SpectralOptions {
+        self.opts
+    }
+
+    /// The remainder rate `ω` in force.
     pub fn omega(&self) -> f64 {
         self.omega
     }
@@ -276,10 +281,19 @@ impl SpectralPatch {
         s
     }
 
+    /// The remainder term `R(u, v) = Σ_i ℓ_i^{(ω)}(u) r_i(θ)`: the part of the patch that is
+    /// not an exact Fourier solution of the PDE. It tends to zero with `M` for continuous
+    /// data (uniformly, as the Fourier tails `r_i` do).
+    pub fn remainder(&self, u: f64, v: f64) -> Vec3 {
+        let theta = self.theta(v);
+        let l = self.rem.eval(u, 0);
+        self.tails(theta, 0).iter().zip(&l[0]).map(|(t, w)| t[0] * *w).sum()
+    }
+
     /// The PDE residual `(∂u² + a²∂θ²)^N` at `(u, v)` of the truncated solution `X̃`, of the
     /// remainder `R` and of the whole `X` (norms of the vector residuals). The truncated
     /// part needs the `2N`-th derivatives of every mode's cardinal functions, which are
-    /// tabulated only for `N ≤ 10`; above that it is `None` (not computed, not assumed).
+    /// tabulated only for `N ≤ 10`; above that the parts are `None` (not computed, not assumed).
     pub fn residual(&self, u: f64, v: f64) -> Residual {
         let n = self.n;
         let k = 2 * n;
@@ -296,16 +310,23 @@ impl SpectralPatch {
             }
             r
         });
-        let l = self.rem.eval(u, k);
-        let tails = self.tails(theta, k);
-        let mut rem = Vec3::ZERO;
-        for q in 0..=n {
-            let w = binom(n, q) * a2.powi((n - q) as i32);
-            for (c, t) in tails.iter().enumerate() {
-                rem += t[2 * (n - q)] * (l[2 * q][c] * w);
+        let rem = (self.rem.kmax() >= k).then(|| {
+            let l = self.rem.eval(u, k);
+            let tails = self.tails(theta, k);
+            let mut rem = Vec3::ZERO;
+            for q in 0..=n {
+                let w = binom(n, q) * a2.powi((n - q) as i32);
+                for (c, t) in tails.iter().enumerate() {
+                    rem += t[2 * (n - q)] * (l[2 * q][c] * w);
+                }
             }
+            rem
+        });
+        Residual {
+            truncated: trunc.map(|t| t.norm()),
+            remainder: rem.map(|r| r.norm()),
+            whole: trunc.zip(rem).map(|(t, r)| (t + r).norm()),
         }
-        Residual { truncated: trunc.map(|t| t.norm()), remainder: rem.norm(), whole: trunc.map(|t| (t + rem).norm()) }
     }
 }
 
@@ -315,7 +336,7 @@ pub struct Residual {
     /// Of the truncated Fourier solution (zero up to round-off by construction).
     pub truncated: Option<f64>,
     /// Of the remainder term.
-    pub remainder: f64,
+    pub remainder: Option<f64>,
     /// Of the whole patch.
     pub whole: Option<f64>,
 }

@@ -687,8 +687,11 @@ fn build_patch(
     let rconds_list = rp.conditions.as_ref().map(|c| c.get_ref()).unwrap_or(&no_conds);
     let conds_span = rp.conditions.as_ref().map(|c| c.span()).or(Some(p.span()));
     let mut conditions = Vec::new();
+    let mut sections = None;
     if let Some(sec) = &rp.sections {
-        conditions.extend(build_sections(ctx, sec, domain, &format!("{key}.sections"))?);
+        let (c, fam) = build_sections(ctx, sec, domain, &format!("{key}.sections"))?;
+        conditions.extend(c);
+        sections = fam;
     }
     for (i, rc) in rconds_list.iter().enumerate() {
         let ck = format!("{key}.conditions[{i}]");
@@ -772,11 +775,16 @@ fn build_patch(
         }
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral })
+    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral, sections })
 }
 
 /// Expands `[patches.NAME.sections]` into position conditions.
-fn build_sections(ctx: &Ctx, sec: &Spanned<RawSections>, domain: VDomain, key: &str) -> R<Vec<Condition>> {
+fn build_sections(
+    ctx: &Ctx,
+    sec: &Spanned<RawSections>,
+    domain: VDomain,
+    key: &str,
+) -> R<(Vec<Condition>, Option<super::SectionFamily>)> {
     let rs = sec.get_ref();
     let count = ctx.int(&rs.count, 2, 200, &format!("{key}.count"))? as usize;
     let us: Vec<f64> = match (&rs.u, &rs.spacing) {
@@ -832,6 +840,7 @@ fn build_sections(ctx: &Ctx, sec: &Spanned<RawSections>, domain: VDomain, key: &
         .map(|(k, t)| Expr::parse(t).map_err(|e| ctx.expr_err(span(&rs.expr), format!("{key}.expr[{k}]"), t, &e)))
         .collect::<R<_>>()?;
     let mut out = Vec::with_capacity(count);
+    let mut ss = Vec::with_capacity(count);
     for (i, &u) in us.iter().enumerate() {
         let idx = i as f64;
         let lookup_i = |n: &str| {
@@ -864,8 +873,26 @@ fn build_sections(ctx: &Ctx, sec: &Spanned<RawSections>, domain: VDomain, key: &
         let data: FieldRef = Arc::new(ExprField::from_exprs(comps, &["v", "t"]));
         check_data(ctx, &data, domain, span(sec), &format!("{key} (section {i}, s = {s_i})"))?;
         out.push(Condition { u, order: 0, data });
+        ss.push(s_i);
     }
-    Ok(out)
+    // The reference family C(v; s), when the curve depends on the index only through s.
+    let family = parsed
+        .iter()
+        .map(|e| {
+            e.bind(&["v", "t", "s"], &|n| {
+                if n == "count" { Some(count as f64) } else { ctx.params.get(n).map(|p| p.value) }
+            })
+            .ok()
+        })
+        .collect::<Option<Vec<Expr>>>()
+        .and_then(|v| <[Expr; 3]>::try_from(v).ok())
+        .filter(|_| us.windows(2).all(|w| w[0] < w[1]))
+        .map(|comps| super::SectionFamily {
+            us: us.clone(),
+            ss,
+            curve: Arc::new(ExprField::from_exprs(comps, &["v", "t", "s"])),
+        });
+    Ok((out, family))
 }
 
 /// Checks that condition data are finite on the domain and, for a periodic patch, closed.

@@ -91,6 +91,31 @@ pub struct ScenePatch {
     pub color: Option<[f64; 3]>,
     /// The spectral solution, for PDE patches (diagnostics).
     pub spectral: Option<Arc<SpectralPatch>>,
+    /// The section family the patch interpolates, when it was given by `sections`.
+    pub sections: Option<SectionFamily>,
+}
+
+/// A family of cross sections `C(v; s)` placed at `(u_i, s_i)`: the reference surface
+/// `C(v; s(u))`, with `s(u)` interpolated linearly between the sections, against which
+/// `check` measures how far the patch strays between its sections.
+#[derive(Clone, Debug)]
+pub struct SectionFamily {
+    /// Section positions `u_i` (increasing).
+    pub us: Vec<f64>,
+    /// Section parameters `s_i`.
+    pub ss: Vec<f64>,
+    /// `C(v, t, s)`.
+    pub curve: Arc<pdeshape_core::data::ExprField>,
+}
+
+impl SectionFamily {
+    /// `s(u)`, linear between neighbouring sections.
+    pub fn s_at(&self, u: f64) -> f64 {
+        let k = self.us.partition_point(|&x| x <= u).clamp(1, self.us.len() - 1);
+        let (u0, u1) = (self.us[k - 1], self.us[k]);
+        let f = if u1 > u0 { (u - u0) / (u1 - u0) } else { 0.0 };
+        self.ss[k - 1] + f * (self.ss[k] - self.ss[k - 1])
+    }
 }
 
 impl std::fmt::Debug for ScenePatch {

@@ -1,0 +1,50 @@
+//! PDE surfaces of any even order (SPEC §3) through the scene files and `check`.
+
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+fn example_text(name: &str) -> String {
+    std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).unwrap()
+}
+
+fn diagnostics(text: &str) -> serde_json::Value {
+    let scene = Scene::parse(text, "test.toml", "test", &HashMap::new()).unwrap_or_else(|e| panic!("{e}"));
+    model::patch_diagnostics(&scene.patches[0])
+}
+
+/// The Klein bottle at Chebyshev sections stays near the analytic bottle; the same 40
+/// sections at equispaced u give the exact solution of a Runge-type swing, which `check`
+/// warns about (SPEC §3 "Many sections").
+#[test]
+fn klein_bottle_sections_chebyshev_versus_equispaced() {
+    let text = example_text("klein-bottle.toml");
+    let d = diagnostics(&text);
+    assert_eq!(d["spectral"]["order"], 40);
+    assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10);
+    let dist = d["section_reference_distance"].as_f64().unwrap();
+    assert!(dist < 0.5, "distance to the analytic bottle {dist}");
+    let leb = d["spectral"]["lebesgue_mode0"].as_f64().unwrap();
+    assert!((3.0..3.5).contains(&leb), "Lebesgue constant {leb}");
+    assert!(d["warnings"].as_array().unwrap().is_empty());
+
+    let d = diagnostics(&text.replace("spacing = \"chebyshev\"", "spacing = \"uniform\""));
+    assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10, "still exact at the sections");
+    let swing = d["section_reference_distance"].as_f64().unwrap();
+    assert!(swing > 1e5, "equispaced sections swing by {swing:e} between the first sections");
+    let w = d["warnings"].as_array().unwrap();
+    assert!(w.iter().any(|w| w.as_str().unwrap().contains("chebyshev")), "{w:?}");
+}
+
+#[test]
+fn check_reports_solver_modes_conditioning_and_residuals() {
+    let d = diagnostics(&example_text("four-curve-patch.toml"));
+    assert_eq!(d["solver"], "spectral");
+    let s = &d["spectral"];
+    assert_eq!(s["modes"], 6);
+    assert!(s["max_mode_condition_number"].as_f64().unwrap() >= 1.0);
+    assert!(s["rms_residual_truncated"].as_f64().unwrap() < 1e-8);
+    assert!(s["rms_residual_whole"].as_f64().unwrap().is_finite());
+    assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10);
+}
