@@ -215,6 +215,13 @@ impl SpectralPatch {
         }
     }
 
+    /// Drops the per-row cache (rows are recomputed on the next evaluation).
+    pub fn clear_row_cache(&self) {
+        if let Ok(mut c) = self.cache.lock() {
+            c.clear();
+        }
+    }
+
     fn theta(&self, v: f64) -> f64 {
         if self.domain.periodic { v } else { (v - self.domain.start) * self.dtheta_dv }
     }
@@ -360,25 +367,47 @@ impl Surface for SpectralPatch {
     }
 
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
-        let cols: Vec<(f64, Vec<Vec<Vec3>>)> = vs
+        // Per column: cos nθ, sin nθ and the tails with their θ-derivative; per row: the
+        // mode functions and their u-derivative. Each point is then a dense sum.
+        struct Col {
+            cs: Vec<(f64, f64)>,
+            tails: Vec<Vec<Vec3>>,
+        }
+        let m = self.opts.modes;
+        let cols: Vec<Col> = vs
             .par_iter()
             .map(|&v| {
                 let th = self.theta(v);
-                (th, self.tails(th, 1))
+                Col {
+                    cs: (0..=m).map(|n| (n as f64 * th).sin_cos()).map(|(s, c)| (c, s)).collect(),
+                    tails: self.tails(th, 1),
+                }
             })
             .collect();
-        let s = self.dtheta_dv;
+        let k = self.dtheta_dv;
         us.par_iter()
             .flat_map_iter(|&u| {
                 let row = self.row(u, 1);
                 cols.iter()
-                    .map(|(th, tails)| {
-                        [
-                            self.combine(&row, tails, *th, 0, 0),
-                            self.combine(&row, tails, *th, 1, 0),
-                            self.combine(&row, tails, *th, 0, 1) * s,
-                            self.combine(&row, tails, *th, 1, 1) * s,
-                        ]
+                    .map(|col| {
+                        let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
+                        for n in 1..=m {
+                            let (c, s) = col.cs[n];
+                            let nf = n as f64;
+                            let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
+                            p += a0 * c + b0 * s;
+                            pu += a1 * c + b1 * s;
+                            pv += (b0 * c - a0 * s) * nf;
+                            puv += (b1 * c - a1 * s) * nf;
+                        }
+                        for (ci, t) in col.tails.iter().enumerate() {
+                            let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
+                            p += t[0] * l0;
+                            pu += t[0] * l1;
+                            pv += t[1] * l0;
+                            puv += t[1] * l1;
+                        }
+                        [p, pu, pv * k, puv * k]
                     })
                     .collect::<Vec<_>>()
             })

@@ -184,3 +184,27 @@ fn open_patches_use_the_even_extension() {
     assert!(rep.max_rel < 1e-12, "{:e}", rep.max_rel);
     let _ = p.point(0.5, 2.0).is_finite();
 }
+
+#[test]
+fn grid_evaluation_matches_pointwise_derivatives() {
+    let a = 0.9;
+    let conds: Vec<Condition> = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
+        .iter()
+        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
+        .collect();
+    for dom in [VDomain::PERIODIC, VDomain::open(0.5, 2.0)] {
+        let p = SpectralPatch::new(&conds, dom, SpectralOptions { a, modes: 3, omega: None }).unwrap();
+        let us = [0.0, 0.3, 0.77, 1.0];
+        let vs = [dom.at(0.1), dom.at(0.45), dom.at(0.9)];
+        let g = p.grid(&us, &vs);
+        for (i, &u) in us.iter().enumerate() {
+            for (j, &v) in vs.iter().enumerate() {
+                let d = p.derivatives(u, v, 1, 1);
+                let want = [d[0], d[2], d[1], d[3]];
+                for k in 0..4 {
+                    assert!((g[i * vs.len() + j][k] - want[k]).norm() < 1e-12, "({u}, {v}) entry {k}");
+                }
+            }
+        }
+    }
+}
