@@ -50,8 +50,8 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     let mut normals = Vec::with_capacity(n);
     let mut uvs = Vec::with_capacity(n);
     let mut scales: Vec<f64> = flat.iter().map(|d| d[1].norm() * d[2].norm()).collect();
-    scales.sort_by(f64::total_cmp);
-    let reference = scales[scales.len() / 2].max(f64::MIN_POSITIVE);
+    let mid = scales.len() / 2;
+    let reference = scales.select_nth_unstable_by(mid, f64::total_cmp).1.max(f64::MIN_POSITIVE);
     let dom = s.v_domain();
     let mut missing = Vec::new();
     for (i, row) in rows.iter().enumerate() {
