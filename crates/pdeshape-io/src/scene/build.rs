@@ -98,14 +98,7 @@ impl Ctx<'_> {
     }
 
     fn field(&self, x: &Spanned<[NumOrExpr; 3]>, vars: &[&str], key: &str) -> R<ExprField> {
-        let texts: Vec<String> = x
-            .get_ref()
-            .iter()
-            .map(|c| match c {
-                NumOrExpr::Num(v) => format!("{v:?}"),
-                NumOrExpr::Expr(s) => s.clone(),
-            })
-            .collect();
+        let texts = x.get_ref().each_ref().map(NumOrExpr::text);
         ExprField::parse([&texts[0], &texts[1], &texts[2]], vars, &self.param_lookup())
             .map_err(|(i, e)| self.expr_err(span(x), format!("{key}[{i}]"), &texts[i], &e))
     }
@@ -825,15 +818,7 @@ fn build_sections(
     let s_text = rs.s.as_ref().map(|s| s.get_ref().clone()).unwrap_or_else(|| "i".into());
     let s_span = rs.s.as_ref().and_then(span);
     let s_expr = Expr::parse(&s_text).map_err(|e| ctx.expr_err(s_span.clone(), format!("{key}.s"), &s_text, &e))?;
-    let texts: Vec<String> = rs
-        .expr
-        .get_ref()
-        .iter()
-        .map(|c| match c {
-            NumOrExpr::Num(v) => format!("{v:?}"),
-            NumOrExpr::Expr(s) => s.clone(),
-        })
-        .collect();
+    let texts = rs.expr.get_ref().each_ref().map(NumOrExpr::text);
     let parsed: Vec<Expr> = texts
         .iter()
         .enumerate()

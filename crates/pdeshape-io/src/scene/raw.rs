@@ -22,6 +22,16 @@ pub enum NumOrExpr {
     Expr(String),
 }
 
+impl NumOrExpr {
+    /// The value as expression text (numbers printed exactly).
+    pub fn text(&self) -> String {
+        match self {
+            NumOrExpr::Num(v) => format!("{v:?}"),
+            NumOrExpr::Expr(s) => s.clone(),
+        }
+    }
+}
+
 /// `[parameters]` entry: `a = 1.5`, `b = "2*a"` or `c = { value = 1, min = 0, max = 2 }`.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
