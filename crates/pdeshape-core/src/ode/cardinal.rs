@@ -27,6 +27,9 @@ pub enum OdeError {
     /// Two conditions are identical.
     #[error("conditions {0} and {1} are identical (both ∂^{2} at u = {3}): they clash")]
     Duplicate(usize, usize, usize, f64),
+    /// The characteristic polynomial is unusable (degenerate, not finite).
+    #[error("characteristic polynomial: {0}")]
+    Polynomial(String),
     /// The condition matrix is singular.
     #[error("the conditions do not determine a unique solution (condition number {cond:.2e}{detail})")]
     Singular {

@@ -12,17 +12,21 @@
 //!   `Re r > 0`, `uᵏ e^{r u}` otherwise (real and imaginary parts for complex `r`),
 //!   every function of modulus ≤ 1 on `[0, 1]` up to the polynomial factor; a zero root of
 //!   multiplicity `m` uses Chebyshev polynomials `T_k(2u − 1)`, `k < m`.
+//! - [`polynomial_roots`] finds the roots of a general real characteristic polynomial
+//!   with their multiplicities, and [`ExpSpace::from_polynomial`] builds `K` from it.
 //! - [`Cardinal`] holds the cardinal functions of a condition set, solved by LU with full
 //!   pivoting, with the condition number of the condition matrix and the Lebesgue
 //!   constant `max_u Σ_i |ℓ_i(u)|` (how much the conditions' data can be amplified between
 //!   them).
 
 mod cardinal;
+mod poly;
 mod precise;
 mod set;
 mod space;
 
 pub use cardinal::{Cardinal, CondSpec, OdeError};
+pub use poly::{CLUSTER_TOL, PolyRoots, polynomial_from_roots, polynomial_roots};
 pub use precise::ChebCardinal;
 pub use set::{CardinalSet, F64_COND_LIMIT};
 pub use space::{ExpSpace, Root};

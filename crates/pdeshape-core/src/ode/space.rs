@@ -42,6 +42,20 @@ impl ExpSpace {
         ExpSpace { roots, dim }
     }
 
+    /// `ker P(D)` for `P(s) = Σ_k c[k] s^k` (real coefficients, any roots): see
+    /// [`polynomial_roots`](super::polynomial_roots).
+    ///
+    /// ```
+    /// use pdeshape_core::ode::ExpSpace;
+    /// // y⁗ + 2y″ + y = 0: roots ±i, each double.
+    /// let k = ExpSpace::from_polynomial(&[1.0, 0.0, 2.0, 0.0, 1.0]).unwrap();
+    /// assert_eq!(k.dim(), 4);
+    /// assert_eq!(k.roots()[0].mult, 2);
+    /// ```
+    pub fn from_polynomial(c: &[f64]) -> Result<Self, super::OdeError> {
+        Ok(Self::from_roots(super::polynomial_roots(c)?.roots))
+    }
+
     /// `ker (D² − c²)^N`: roots `±c` of multiplicity `N` (polynomials of degree `2N − 1`
     /// when `c = 0`). This is mode `n` of `(∂u² + a²∂v²)^N` with `c = a n`.
     pub fn symmetric(c: f64, n: usize) -> Self {
