@@ -96,18 +96,27 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     });
     if let Some(fam) = &p.sections {
         // How far the patch strays from the section family between its sections.
-        let mut worst: f64 = 0.0;
-        for i in 0..=400 {
-            let u = i as f64 / 400.0;
-            let s = fam.s_at(u);
-            for j in 0..48 {
-                let v = dom.at((j as f64 + 0.25) / 48.0);
-                let x = p.surface.point(u, v);
-                let r = pdeshape_core::data::Field::eval(fam.curve.as_ref(), &[v, 0.0, s]);
-                worst = worst.max((x - r).norm());
+        let distance = |s_of: &dyn Fn(f64) -> f64| {
+            let (mut worst, mut at): (f64, [f64; 3]) = (0.0, [0.0; 3]);
+            for i in 0..=400 {
+                let u = i as f64 / 400.0;
+                let s = s_of(u);
+                for j in 0..48 {
+                    let v = dom.at((j as f64 + 0.25) / 48.0);
+                    let x = p.surface.point(u, v);
+                    let r = pdeshape_core::data::Field::eval(fam.curve.as_ref(), &[v, 0.0, s]);
+                    let dist = (x - r).norm();
+                    if dist > worst {
+                        (worst, at) = (dist, [u, v, s]);
+                    }
+                }
             }
-        }
+            (worst, at)
+        };
+        let (worst, at) = distance(&|u| fam.s_at(u));
         d["section_reference_distance"] = json!(worst);
+        d["section_reference_distance_linear_s"] = json!(distance(&|u| fam.s_linear(u)).0);
+        d["section_reference_worst"] = json!({"u": at[0], "v": at[1], "s": at[2]});
     }
     if let Some(sp) = &p.spectral {
         let r = sp.report();

@@ -250,7 +250,11 @@ fn execute(cli: Cli) -> Result<()> {
                         );
                     }
                     if let Some(x) = p["section_reference_distance"].as_f64() {
-                        println!("      max distance to the section family at interpolated s: {x:.4}");
+                        let lin = p["section_reference_distance_linear_s"].as_f64().unwrap_or(f64::NAN);
+                        println!(
+                            "      max distance to the section family at the fractional section index: {x:.4} \
+                             (s linear in u between sections: {lin:.4})"
+                        );
                     }
                     for w in p["warnings"].as_array().into_iter().flatten() {
                         println!("      warning: {}", w.as_str().unwrap_or(""));

@@ -24,7 +24,7 @@ fn klein_bottle_sections_chebyshev_versus_equispaced() {
     assert_eq!(d["spectral"]["order"], 40);
     assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10);
     let dist = d["section_reference_distance"].as_f64().unwrap();
-    assert!(dist < 0.5, "distance to the analytic bottle {dist}");
+    assert!(dist < 0.25, "distance to the analytic bottle {dist}");
     let leb = d["spectral"]["lebesgue_mode0"].as_f64().unwrap();
     assert!((3.0..3.5).contains(&leb), "Lebesgue constant {leb}");
     assert!(d["warnings"].as_array().unwrap().is_empty());

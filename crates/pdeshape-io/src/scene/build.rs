@@ -861,6 +861,14 @@ fn build_sections(
         ss.push(s_i);
     }
     // The reference family C(v; s), when the curve depends on the index only through s.
+    let spacing = match (&rs.u, rs.spacing.as_ref().map(|s| s.get_ref().as_str())) {
+        (Some(_), _) => super::Spacing::Explicit,
+        (None, Some("uniform")) => super::Spacing::Uniform,
+        _ => super::Spacing::Chebyshev,
+    };
+    let s_of_index = s_expr
+        .bind(&["i"], &|n| if n == "count" { Some(count as f64) } else { ctx.params.get(n).map(|p| p.value) })
+        .ok();
     let family = parsed
         .iter()
         .map(|e| {
@@ -872,9 +880,12 @@ fn build_sections(
         .collect::<Option<Vec<Expr>>>()
         .and_then(|v| <[Expr; 3]>::try_from(v).ok())
         .filter(|_| us.windows(2).all(|w| w[0] < w[1]))
-        .map(|comps| super::SectionFamily {
+        .zip(s_of_index)
+        .map(|(comps, s_of_index)| super::SectionFamily {
             us: us.clone(),
             ss,
+            spacing,
+            s_of_index,
             curve: Arc::new(ExprField::from_exprs(comps, &["v", "t", "s"])),
         });
     Ok((out, family))

@@ -95,22 +95,61 @@ pub struct ScenePatch {
     pub sections: Option<SectionFamily>,
 }
 
-/// A family of cross sections `C(v; s)` placed at `(u_i, s_i)`: the reference surface
-/// `C(v; s(u))`, with `s(u)` interpolated linearly between the sections, against which
-/// `check` measures how far the patch strays between its sections.
+/// A family of cross sections `C(v; s)` placed at `(u_i, s_i)`, against which `check`
+/// measures how far the patch strays between its sections.
+///
+/// Between sections the reference is `C(v; s(i(u)))` at the *fractional section index*
+/// `i(u)`: the inverse of the spacing map (`u_i = i/m` for uniform,
+/// `u_i = (1 − cos(πi/m))/2` for Chebyshev spacing, `m = count − 1`; linear between explicit
+/// `u_i`), with `s` the scene's `s(i)` expression. [`SectionFamily::s_linear`] is the cruder
+/// reference with `s` linear in `u` between neighbouring sections.
 #[derive(Clone, Debug)]
 pub struct SectionFamily {
     /// Section positions `u_i` (increasing).
     pub us: Vec<f64>,
     /// Section parameters `s_i`.
     pub ss: Vec<f64>,
+    /// How the `u_i` were placed.
+    pub spacing: Spacing,
+    /// `s(i)`, the section parameter at a (fractional) index.
+    pub s_of_index: pdeshape_core::expr::Expr,
     /// `C(v, t, s)`.
     pub curve: Arc<pdeshape_core::data::ExprField>,
 }
 
+/// The placement of sections in `u`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spacing {
+    /// `u_i = i/m`.
+    Uniform,
+    /// `u_i = (1 − cos(πi/m))/2`.
+    Chebyshev,
+    /// Given explicitly.
+    Explicit,
+}
+
 impl SectionFamily {
-    /// `s(u)`, linear between neighbouring sections.
+    /// The fractional section index `i(u)` (inverse of the spacing map).
+    pub fn index_at(&self, u: f64) -> f64 {
+        let m = (self.us.len() - 1) as f64;
+        match self.spacing {
+            Spacing::Uniform => u * m,
+            Spacing::Chebyshev => m * (1.0 - 2.0 * u).clamp(-1.0, 1.0).acos() / std::f64::consts::PI,
+            Spacing::Explicit => {
+                let k = self.us.partition_point(|&x| x <= u).clamp(1, self.us.len() - 1);
+                let (u0, u1) = (self.us[k - 1], self.us[k]);
+                (k - 1) as f64 + if u1 > u0 { (u - u0) / (u1 - u0) } else { 0.0 }
+            }
+        }
+    }
+
+    /// `s(i(u))`: the section parameter at the fractional index of `u`.
     pub fn s_at(&self, u: f64) -> f64 {
+        self.s_of_index.eval(&[self.index_at(u)])
+    }
+
+    /// `s(u)`, linear between neighbouring sections.
+    pub fn s_linear(&self, u: f64) -> f64 {
         let k = self.us.partition_point(|&x| x <= u).clamp(1, self.us.len() - 1);
         let (u0, u1) = (self.us[k - 1], self.us[k]);
         let f = if u1 > u0 { (u - u0) / (u1 - u0) } else { 0.0 };
