@@ -15,6 +15,7 @@
 
 #![warn(missing_docs)]
 
+pub mod blend;
 pub mod data;
 pub mod expr;
 pub mod jet;

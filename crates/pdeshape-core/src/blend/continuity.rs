@@ -1,0 +1,137 @@
+//! Continuity of a blend with its primary surfaces along the trimlines.
+
+use crate::Vec3;
+use crate::data::{FieldRef, curve_derivative};
+use crate::patch::Surface;
+
+/// The gaps at one point of a trimline between the blend `X` at `(u_e, v)` and the
+/// primary surface `S`, whose cross derivatives `∂ᵏS/∂uᵏ` (in the blend's `u`, i.e. scaled
+/// trimline data) are the fields `data[k]`. Entries are `None` when the needed data are
+/// not available.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Gaps {
+    /// `|X − S|` (C0).
+    pub c0: Option<f64>,
+    /// `|X_u − S_u|` (C1, parametric).
+    pub c1: Option<f64>,
+    /// Angle in radians between the normals `X_u × X_v` and `S_u × S_v` (G1).
+    pub g1: Option<f64>,
+    /// `|X_uu − S_uu|` (C2, parametric).
+    pub c2: Option<f64>,
+    /// `|κ_X − κ_S|`: difference of the normal curvatures in the direction across the
+    /// trimline (tangent, perpendicular to the trimline) (G2).
+    pub g2: Option<f64>,
+}
+
+impl Gaps {
+    /// Entry-wise maximum.
+    pub fn max(self, o: Gaps) -> Gaps {
+        let m = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(x), Some(y)) => Some(x.max(y)),
+            (x, None) => x,
+            (None, y) => y,
+        };
+        Gaps {
+            c0: m(self.c0, o.c0),
+            c1: m(self.c1, o.c1),
+            g1: m(self.g1, o.g1),
+            c2: m(self.c2, o.c2),
+            g2: m(self.g2, o.g2),
+        }
+    }
+}
+
+/// Normal curvature across the curve `v ↦ X(u_e, v)`: with the first fundamental form
+/// `E, F, G` and second `L, M, N` (unit normal `n = X_u × X_v / |…|`), the tangent
+/// direction perpendicular to `X_v` is `(du, dv) = (1, −F/G)`, so
+/// `κ = (L − 2M F/G + N F²/G²) / (E − F²/G)`.
+fn cross_curvature(xu: Vec3, xv: Vec3, xuu: Vec3, xuv: Vec3, xvv: Vec3) -> Option<f64> {
+    let n = xu.cross(xv).normalized()?;
+    let (e, f, g) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
+    if g == 0.0 {
+        return None;
+    }
+    let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
+    let lam = f / g;
+    let den = e - f * lam;
+    (den > 0.0).then(|| (l - 2.0 * m * lam + nn * lam * lam) / den)
+}
+
+fn angle(a: Vec3, b: Vec3) -> Option<f64> {
+    let (a, b) = (a.normalized()?, b.normalized()?);
+    Some(a.cross(b).norm().atan2(a.dot(b)))
+}
+
+/// The gaps at `(u_e, v)`; `data[k]` is `∂ᵏS/∂uᵏ` along the trimline, `k = 0, 1, 2`.
+pub fn gaps_at(x: &dyn Surface, u_e: f64, v: f64, data: [Option<&FieldRef>; 3]) -> Gaps {
+    let d = x.derivatives(u_e, v, 2, 2);
+    let at = |i: usize, j: usize| d[i * 3 + j];
+    let mut g = Gaps::default();
+    let Some(s0) = data[0] else { return g };
+    g.c0 = Some((at(0, 0) - s0.eval(&[v, 0.0])).norm());
+    let Some(s1) = data[1] else { return g };
+    let su = s1.eval(&[v, 0.0]);
+    let sv = curve_derivative(s0.as_ref(), v, 0.0, 1);
+    g.c1 = Some((at(1, 0) - su).norm());
+    g.g1 = angle(at(1, 0).cross(at(0, 1)), su.cross(sv));
+    let Some(s2) = data[2] else { return g };
+    let suu = s2.eval(&[v, 0.0]);
+    g.c2 = Some((at(2, 0) - suu).norm());
+    let suv = curve_derivative(s1.as_ref(), v, 0.0, 1);
+    let svv = curve_derivative(s0.as_ref(), v, 0.0, 2);
+    let kx = cross_curvature(at(1, 0), at(0, 1), at(2, 0), at(1, 1), at(0, 2));
+    let ks = cross_curvature(su, sv, suu, suv, svv);
+    g.g2 = kx.zip(ks).map(|(a, b)| (a - b).abs());
+    g
+}
+
+/// The largest gaps over `samples` points of the trimline `u = u_e`.
+pub fn continuity(x: &dyn Surface, u_e: f64, data: [Option<&FieldRef>; 3], samples: usize) -> Gaps {
+    let dom = x.v_domain();
+    (0..samples)
+        .map(|i| gaps_at(x, u_e, dom.at((i as f64 + 0.5) / samples as f64), data))
+        .fold(Gaps::default(), Gaps::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{ExprField, Trimline};
+    use crate::patch::VDomain;
+    use std::sync::Arc;
+
+    /// A cylinder of radius 2 as its own "blend": every gap vanishes against its trimline
+    /// data, and the cross curvature of the sphere of radius 3 is 1/3 in magnitude.
+    struct Param(ExprField);
+    impl Surface for Param {
+        fn v_domain(&self) -> VDomain {
+            VDomain::PERIODIC
+        }
+        fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+            let j = crate::data::Field::jet(&self.0, &[u, v, 0.0], crate::jet::JetShape::new(&[du, dv]));
+            let mut out = Vec::new();
+            for i in 0..=du {
+                for k in 0..=dv {
+                    out.push(j.derivative([i, k, 0]));
+                }
+            }
+            out
+        }
+    }
+
+    #[test]
+    fn identical_surfaces_have_no_gaps_and_curvature_is_right() {
+        let e = ["3*sin(s)*cos(v)", "3*sin(s)*sin(v)", "3*cos(s)"];
+        let f = ExprField::parse(e, &["s", "v", "t"], &|_| None).unwrap();
+        let fr: FieldRef = Arc::new(f.clone());
+        let data: Vec<FieldRef> =
+            (0..3).map(|k| Arc::new(Trimline::new(fr.clone(), 1.0, k, 1.0)) as FieldRef).collect();
+        let g = continuity(&Param(f.clone()), 1.0, [Some(&data[0]), Some(&data[1]), Some(&data[2])], 50);
+        for x in [g.c0, g.c1, g.g1, g.c2, g.g2] {
+            assert!(x.unwrap() < 1e-13, "{g:?}");
+        }
+        let d = Param(f).derivatives(1.0, 0.4, 2, 2);
+        let k = cross_curvature(d[3], d[1], d[6], d[4], d[2]).unwrap();
+        assert!((k.abs() - 1.0 / 3.0).abs() < 1e-13, "{k}");
+    }
+}
