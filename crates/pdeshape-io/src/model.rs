@@ -2,7 +2,10 @@
 
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
-use pdeshape_core::mesh::{GridOptions, Mesh, grid_mesh};
+use pdeshape_core::blend::{Gaps, Solver, StaticBlend, continuity, gaps_at};
+use pdeshape_core::data::FieldRef;
+use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
+use pdeshape_core::patch::{Condition, Surface};
 use pdeshape_core::patch::{PrimarySurface, check_conditions};
 use serde_json::{Value, json};
 
@@ -22,8 +25,49 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
         let pts: Vec<_> = (0..=n).map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64))).collect();
         m.curves.push(pts);
     }
+    if let Some(b) = &p.blend {
+        add_continuity_fields(&mut m, p, b.blend.as_ref());
+    }
     m.check_finite()?;
     Ok(m)
+}
+
+/// The trimline data `∂ᵏS/∂uᵏ`, `k = 0, 1, 2`, at the blend end `u_e`, from the patch's
+/// conditions.
+pub fn end_data(p: &ScenePatch, u_e: f64) -> [Option<FieldRef>; 3] {
+    std::array::from_fn(|k| p.conditions.iter().find(|c| c.u == u_e && c.order == k).map(|c| c.data.clone()))
+}
+
+/// Per-vertex continuity fields of a blend: at each vertex, the gap of its `v` on the
+/// nearer trimline (`u = 0` for `u < ½`): `c0_gap`, `c1_gap`, `g1_angle` (radians),
+/// `c2_gap`, `g2_gap` (SPEC §4 continuity diagnostics).
+fn add_continuity_fields(m: &mut Mesh, p: &ScenePatch, s: &dyn pdeshape_core::patch::Surface) {
+    use rayon::prelude::*;
+    let dom = s.v_domain();
+    let ends = [end_data(p, 0.0), end_data(p, 1.0)];
+    let gaps: Vec<Gaps> = m
+        .uvs
+        .par_iter()
+        .map(|uv| {
+            let e = usize::from(uv[0] >= 0.5);
+            let d = &ends[e];
+            gaps_at(s, e as f64, dom.at(uv[1]), [d[0].as_ref(), d[1].as_ref(), d[2].as_ref()])
+        })
+        .collect();
+    type Pick = fn(&Gaps) -> Option<f64>;
+    let picks: [(&str, Pick); 5] = [
+        ("c0_gap", |g| g.c0),
+        ("c1_gap", |g| g.c1),
+        ("g1_angle", |g| g.g1),
+        ("c2_gap", |g| g.c2),
+        ("g2_gap", |g| g.g2),
+    ];
+    for (name, pick) in picks {
+        if gaps.iter().all(|g| pick(g).is_some()) {
+            let values = gaps.iter().map(|g| pick(g).unwrap_or(0.0)).collect();
+            m.fields.push(ScalarField { name: name.into(), values });
+        }
+    }
 }
 
 /// Meshes of all patches, in scene order.
@@ -60,12 +104,68 @@ pub fn render_meshes(patches: &[Mesh], context: &[Mesh], colors: &[Option<[f64; 
     render(&items, &cam)
 }
 
-/// Renders the whole scene.
+/// Renders the whole scene. A scene of several blends between the same surfaces (an
+/// order study) becomes a strip with one panel per blend ([`blend_strip`]).
 pub fn render_scene(scene: &Scene) -> Result<Image, String> {
+    if let Some(strip) = blend_strip(scene) {
+        return strip;
+    }
     let patches = patch_meshes(scene)?;
     let context = context_meshes(scene)?;
     let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
     Ok(render_meshes(&patches, &context, &colors, &scene.render))
+}
+
+/// For scenes whose patches are all blends (two or more): one panel per blend, drawn with
+/// the primary surfaces, and its continuity numbers printed under it.
+pub fn blend_strip(scene: &Scene) -> Option<Result<Image, String>> {
+    if scene.patches.len() < 2 || scene.patches.iter().any(|p| p.blend.is_none()) {
+        return None;
+    }
+    let run = || -> Result<Image, String> {
+        let context = context_meshes(scene)?;
+        let n = scene.patches.len() as u32;
+        let mut r = scene.render.clone();
+        let w = (scene.render.size.0 * 2 / n.min(3)).clamp(64, 520);
+        r.size = (w, w * 5 / 4);
+        let caption_h = 118;
+        let mut panels = Vec::new();
+        for (k, p) in scene.patches.iter().enumerate() {
+            let m = patch_mesh(p)?;
+            let img = render_meshes(std::slice::from_ref(&m), &context, &[p.color.or(Some(palette(k)))], &r);
+            let mut panel = Image::new(img.width, img.height + caption_h, [255, 255, 255]);
+            panel.paste(&img, 0, 0);
+            let d = patch_diagnostics(p);
+            let c = &d["continuity"];
+            let f = |e: &str, key: &str| {
+                let a = c["start"][key].as_f64();
+                let b = c["end"][key].as_f64();
+                match (a, b) {
+                    (Some(a), Some(b)) => format!("{:.1e}", a.max(b)),
+                    _ => "-".into(),
+                }
+                .replace("e0", "")
+                    + e
+            };
+            let text = format!(
+                "{}  ({})\nC0 gap {}\nG1 angle {}\nC2 gap {}   G2 {}",
+                p.name,
+                c["class"].as_str().unwrap_or("?"),
+                f("", "c0"),
+                f(" rad", "g1_radians"),
+                f("", "c2"),
+                f("", "g2"),
+            );
+            crate::render::draw_text(&mut panel, 14.0, img.height as f32 + 6.0, 20.0, &text, [30, 30, 40]);
+            panels.push(panel);
+        }
+        Ok(Image::strip(&panels, 6, [255, 255, 255]))
+    };
+    Some(run())
+}
+
+fn palette(k: usize) -> [f64; 3] {
+    PALETTE[k % PALETTE.len()].map(f64::from)
 }
 
 /// Lebesgue constant above which `check` warns that the condition set amplifies its data
@@ -74,14 +174,19 @@ pub const LEBESGUE_WARNING: f64 = 1e3;
 
 /// Diagnostics of one patch, as `check --json` prints them.
 pub fn patch_diagnostics(p: &ScenePatch) -> Value {
-    let rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
+    let mut rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
+    if let Some(b) = &p.blend {
+        rep = blend_condition_report(b.blend.as_ref(), &p.conditions);
+    }
     let dom = p.surface.v_domain();
     let mut d = json!({
         "name": p.name,
         "kind": p.kind.name(),
-        "solver": match p.kind {
-            crate::scene::PatchKind::Hermite => "hermite-interpolation",
-            crate::scene::PatchKind::Pde => "spectral",
+        "solver": match (&p.kind, &p.blend) {
+            (crate::scene::PatchKind::Hermite, _) => "hermite-interpolation".to_string(),
+            (crate::scene::PatchKind::Pde, _) => "spectral".to_string(),
+            (_, Some(b)) => blend_solver_name(b.blend.as_ref()),
+            (_, None) => "none".to_string(),
         },
         "conditions": p.conditions.iter().map(|c| json!({"u": c.u, "order": c.order})).collect::<Vec<_>>(),
         "v_domain": {"start": dom.start, "end": dom.end, "periodic": dom.periodic},
@@ -117,6 +222,9 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         d["section_reference_distance"] = json!(worst);
         d["section_reference_distance_linear_s"] = json!(distance(&|u| fam.s_linear(u)).0);
         d["section_reference_worst"] = json!({"u": at[0], "v": at[1], "s": at[2]});
+    }
+    if let Some(b) = &p.blend {
+        blend_diagnostics(p, b, &mut d, rep.size);
     }
     if let Some(sp) = &p.spectral {
         let r = sp.report();
@@ -168,6 +276,136 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     d
 }
 
+/// `"exact"`, `"collocation"` or the per-component mix.
+fn blend_solver_name(b: &StaticBlend) -> String {
+    let r = b.reports();
+    if r.iter().all(|c| c.solver == r[0].solver) {
+        r[0].solver.to_string()
+    } else {
+        format!("mixed (x: {}, y: {}, z: {})", r[0].solver, r[1].solver, r[2].solver)
+    }
+}
+
+/// The condition check of a blend: each component against the conditions its order takes
+/// (a 2nd-order component takes positions only, and is not expected to meet the others).
+pub fn blend_condition_report(b: &StaticBlend, conds: &[Condition]) -> pdeshape_core::patch::ConditionReport {
+    let positions: Vec<Condition> = conds.iter().filter(|c| c.order == 0).cloned().collect();
+    let mut rep = check_conditions(b, &positions, 0.0, CHECK_SAMPLES);
+    let dom = b.v_domain();
+    for (t, op) in b.operators().iter().enumerate() {
+        for c in conds.iter().filter(|c| c.order < op.half_order()) {
+            for i in 0..CHECK_SAMPLES {
+                let v = dom.at((i as f64 + 0.37) / CHECK_SAMPLES as f64);
+                let e = (b.u_derivative(c.u, v, c.order)[t] - c.data.eval(&[v, 0.0])[t]).abs();
+                rep.max_abs = rep.max_abs.max(e);
+            }
+        }
+    }
+    rep.max_rel = rep.max_abs / rep.size.max(f64::MIN_POSITIVE);
+    rep
+}
+
+/// Thresholds of the continuity classification, relative to the patch size (C0, C1, C2)
+/// and absolute (G1 in radians, G2 in curvature × size).
+pub const CONTINUITY_TOL: f64 = 1e-8;
+
+/// The highest continuity met at both ends: `"none"`, `"C0"`, `"G1"`, `"C1"`, `"G2"`,
+/// `"C2"` (C2 includes G2; G2 is reported when curvature matches without C2).
+pub fn continuity_class(ends: &[Gaps], size: f64) -> &'static str {
+    let ok = |f: fn(&Gaps) -> Option<f64>, tol: f64| ends.iter().all(|g| f(g).is_some_and(|x| x <= tol));
+    let tol = CONTINUITY_TOL * size.max(1e-300);
+    if !ok(|g| g.c0, tol) {
+        return "none";
+    }
+    if !ok(|g| g.g1, CONTINUITY_TOL) {
+        return "C0";
+    }
+    let c1 = ok(|g| g.c1, tol);
+    let g2 = ok(|g| g.g2, CONTINUITY_TOL / size.max(1e-300));
+    if c1 && ok(|g| g.c2, tol) {
+        return "C2";
+    }
+    if g2 {
+        return "G2";
+    }
+    if c1 { "C1" } else { "G1" }
+}
+
+fn gaps_json(g: &Gaps) -> Value {
+    json!({ "c0": g.c0, "c1": g.c1, "g1_radians": g.g1, "c2": g.c2, "g2": g.g2 })
+}
+
+fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut Value, size: f64) {
+    let b = setup.blend.as_ref();
+    let comps: Vec<Value> = b
+        .reports()
+        .iter()
+        .zip(["x", "y", "z"])
+        .zip(b.operators())
+        .map(|((r, axis), op)| {
+            json!({
+                "component": axis,
+                "order": r.order,
+                "coefficients": op.coefficients(),
+                "elliptic": r.elliptic,
+                "solver": r.solver,
+                "exact_available": r.exact_available,
+                "basis": r.basis,
+                "condition_number": r.condition_number,
+                "collocation_rms_residual": r.collocation_rms,
+                "collocation": r.collocation.map(|(l, q, nb)| json!({"u_points": l, "v_points": q, "bubbles": nb})),
+            })
+        })
+        .collect();
+    // When both solvers apply, how far apart their surfaces are.
+    let both = b.reports().iter().all(|r| r.exact_available);
+    let distance = both
+        .then(|| {
+            let ran_exact = b.reports().iter().all(|r| r.solver == "exact");
+            let other = pdeshape_core::blend::BlendOptions {
+                solver: if ran_exact { Solver::Collocation } else { Solver::Exact },
+                ..setup.options.clone()
+            };
+            let q = StaticBlend::new(b.operators().clone(), &p.conditions, b.v_domain(), &other).ok()?;
+            let dom = b.v_domain();
+            let mut worst: f64 = 0.0;
+            for i in 0..=50 {
+                for j in 0..50 {
+                    let (u, v) = (i as f64 / 50.0, dom.at((j as f64 + 0.5) / 50.0));
+                    worst = worst.max((b.point(u, v) - q.point(u, v)).norm());
+                }
+            }
+            Some(worst)
+        })
+        .flatten();
+    let ends: Vec<Gaps> = [0.0, 1.0]
+        .iter()
+        .map(|&u| {
+            let e = end_data(p, u);
+            continuity(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], 400)
+        })
+        .collect();
+    d["blend"] = json!({
+        "components": comps,
+        "exact_vs_collocation_max_distance": distance,
+    });
+    d["continuity"] = json!({
+        "start": gaps_json(&ends[0]),
+        "end": gaps_json(&ends[1]),
+        "class": continuity_class(&ends, size),
+        "samples": 400,
+    });
+    for (r, axis) in b.reports().iter().zip(["x", "y", "z"]) {
+        if !r.elliptic
+            && let Some(w) = d["warnings"].as_array_mut()
+        {
+            w.push(json!(format!(
+                "component {axis}: the operator is not elliptic; the blend is solved per mode but is not well posed for all data"
+            )));
+        }
+    }
+}
+
 /// The convergence study of a PDE patch over an interior grid for `M = 1 … 16` modes
 /// (ω = a (M + 1)), as a plot: max and RMS PDE residual of the whole patch, and the size of
 /// the remainder. For data whose derivatives of order 2N are not continuous (polylines,
@@ -214,6 +452,55 @@ pub fn convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
             crate::render::Series { label: "RMS PDE residual".into(), points: rms_pts },
             crate::render::Series { label: "max |remainder R|".into(), points: rem_pts },
         ],
+        true,
+        (640, 420),
+    ))
+}
+
+/// The convergence of the collocation solver to the exact one on eigenfunction data: for
+/// each blend patch of the scene whose data allow the exact solver, the max distance
+/// between the two surfaces on a 41 × 48 grid for `B = 1 … 14` bubble functions. `None`
+/// when no patch qualifies.
+pub fn blend_convergence_plot(scene: &Scene) -> Option<Result<Image, String>> {
+    use pdeshape_core::blend::BlendOptions;
+    let mut series = Vec::new();
+    for p in &scene.patches {
+        let Some(setup) = &p.blend else { continue };
+        let b = setup.blend.as_ref();
+        if !b.reports().iter().all(|r| r.exact_available) {
+            continue;
+        }
+        let dom = b.v_domain();
+        let opts = |solver, bubbles| BlendOptions { solver, bubbles, collocation: None, ..setup.options.clone() };
+        let Ok(exact) = StaticBlend::new(b.operators().clone(), &p.conditions, dom, &opts(Solver::Exact, 1)) else {
+            continue;
+        };
+        let mut pts = Vec::new();
+        for nb in 1..=14usize {
+            let Ok(q) = StaticBlend::new(b.operators().clone(), &p.conditions, dom, &opts(Solver::Collocation, nb))
+            else {
+                continue;
+            };
+            let mut worst: f64 = 0.0;
+            for i in 0..=40 {
+                for j in 0..48 {
+                    let (u, v) = (i as f64 / 40.0, dom.at((j as f64 + 0.5) / 48.0));
+                    worst = worst.max((q.point(u, v) - exact.point(u, v)).norm());
+                }
+            }
+            // exact agreement shows as the round-off floor
+            pts.push((nb as f64, worst.max(1e-16)));
+        }
+        series.push(crate::render::Series { label: p.name.clone(), points: pts });
+    }
+    if series.is_empty() {
+        return None;
+    }
+    Some(crate::render::line_plot(
+        "collocation vs exact: max distance as the bubble count grows",
+        "bubble functions B",
+        "max |X_collocation − X_exact|",
+        &series,
         true,
         (640, 420),
     ))

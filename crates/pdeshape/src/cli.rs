@@ -4,7 +4,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
-use pdeshape_io::scene::Scene;
+use pdeshape_io::scene::{LoadOptions, Scene};
 use std::collections::HashMap;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
@@ -36,13 +36,16 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
     },
-    /// Diagnose a scene: solver, condition errors, conditioning.
+    /// Diagnose a scene: solver, condition errors, conditioning, continuity.
     Check {
         /// Scene file (TOML).
         scene: PathBuf,
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Solver for blends: auto, exact or collocation (overrides the scene).
+        #[arg(long)]
+        solver: Option<String>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
@@ -57,6 +60,9 @@ enum Command {
         /// Time, for dynamic blends.
         #[arg(long)]
         time: Option<f64>,
+        /// Solver for blends: auto, exact or collocation (overrides the scene).
+        #[arg(long)]
+        solver: Option<String>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
@@ -135,10 +141,41 @@ fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
 }
 
 pub fn load(path: &Path, set: &[String]) -> Result<Scene> {
+    load_with(path, set, None)
+}
+
+/// Loads a scene with parameter overrides and an optional solver override.
+pub fn load_with(path: &Path, set: &[String], solver: Option<&str>) -> Result<Scene> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {}", path.display()))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    Ok(Scene::parse(&text, &path.display().to_string(), &name, &overrides(set)?)?)
+    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string) };
+    Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
+}
+
+/// The continuity line of a blend's diagnostics: the gaps at both trimlines and the class.
+pub fn continuity_line(p: &serde_json::Value) -> Option<String> {
+    let c = &p["continuity"];
+    if !c.is_object() {
+        return None;
+    }
+    let f = |x: &serde_json::Value| x.as_f64().map(|v| format!("{v:.1e}")).unwrap_or_else(|| "-".into());
+    let end = |e: &serde_json::Value| {
+        format!(
+            "C0 {} C1 {} G1 {} rad C2 {} G2 {}",
+            f(&e["c0"]),
+            f(&e["c1"]),
+            f(&e["g1_radians"]),
+            f(&e["c2"]),
+            f(&e["g2"])
+        )
+    };
+    Some(format!(
+        "continuity {}: u=0 [{}]  u=1 [{}]",
+        c["class"].as_str().unwrap_or("?"),
+        end(&c["start"]),
+        end(&c["end"])
+    ))
 }
 
 fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
@@ -153,9 +190,14 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for f in &scene.formats {
         if f == "png" {
-            let context = model::context_meshes(scene).map_err(|e| anyhow!(e))?;
-            let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
-            let img = model::render_meshes(&meshes, &context, &colors, &scene.render);
+            let img = match model::blend_strip(scene) {
+                Some(strip) => strip.map_err(|e| anyhow!(e))?,
+                None => {
+                    let context = model::context_meshes(scene).map_err(|e| anyhow!(e))?;
+                    let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
+                    model::render_meshes(&meshes, &context, &colors, &scene.render)
+                }
+            };
             let path = dir.join(format!("{}.png", scene.name));
             write_png(&path, &img)?;
             written.push(path);
@@ -215,12 +257,15 @@ fn execute(cli: Cli) -> Result<()> {
                         d["solver"].as_str().unwrap_or(""),
                         d["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
                     );
+                    if let Some(line) = continuity_line(&d) {
+                        eprintln!("  {line}");
+                    }
                 }
             }
             Ok(())
         }
-        Command::Check { scene, json, set } => {
-            let sc = load(&scene, &set)?;
+        Command::Check { scene, json, set, solver } => {
+            let sc = load_with(&scene, &set, solver.as_deref())?;
             let d = model::scene_diagnostics(&sc);
             if json {
                 println!("{}", serde_json::to_string_pretty(&d)?);
@@ -249,6 +294,28 @@ fn execute(cli: Cli) -> Result<()> {
                             sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
                         );
                     }
+                    if let Some(line) = continuity_line(p) {
+                        println!("      {line}");
+                    }
+                    if let Some(b) = p["blend"].as_object() {
+                        for c in b["components"].as_array().into_iter().flatten() {
+                            println!(
+                                "      {}: order {}, solver {}, {} basis functions, condition {:.2e}{}",
+                                c["component"].as_str().unwrap_or(""),
+                                c["order"],
+                                c["solver"].as_str().unwrap_or(""),
+                                c["basis"].as_array().map(|a| a.len()).unwrap_or(0),
+                                c["condition_number"].as_f64().unwrap_or(f64::NAN),
+                                c["collocation_rms_residual"]
+                                    .as_f64()
+                                    .map(|r| format!(", collocation RMS residual {r:.2e}"))
+                                    .unwrap_or_default()
+                            );
+                        }
+                        if let Some(x) = b["exact_vs_collocation_max_distance"].as_f64() {
+                            println!("      max distance between the exact and the collocation solution: {x:.3e}");
+                        }
+                    }
                     if let Some(x) = p["section_reference_distance"].as_f64() {
                         let lin = p["section_reference_distance_linear_s"].as_f64().unwrap_or(f64::NAN);
                         println!(
@@ -263,8 +330,8 @@ fn execute(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Sample { scene, patch, time, set } => {
-            let sc = load(&scene, &set)?;
+        Command::Sample { scene, patch, time, set, solver } => {
+            let sc = load_with(&scene, &set, solver.as_deref())?;
             let p = match &patch {
                 Some(n) => sc.patch(n).ok_or_else(|| {
                     anyhow!(

@@ -65,6 +65,17 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
             return e;
         }
     }
+    if let Some(plot) = model::blend_convergence_plot(&scene) {
+        match plot {
+            Ok(img) => {
+                let rel = format!("{name}/{name}-collocation-convergence.png");
+                if pdeshape_io::export::write_atomic(&dir.join(&rel), |w| img.write_png(w)).is_ok() {
+                    e.plots.push(rel);
+                }
+            }
+            Err(err) => e.error = Some(err),
+        }
+    }
     for p in &scene.patches {
         if let Some(plot) = model::convergence_plot(p) {
             match plot {

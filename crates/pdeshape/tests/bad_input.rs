@@ -327,3 +327,49 @@ fn bad_arguments_and_stdin() {
     assert!(err.contains("unknown output format `.dwg`"), "{err}");
     assert!(!dir.path().join("x.dwg").exists());
 }
+
+fn blend(extra: &str) -> String {
+    format!(
+        "{GOOD_CURVES}\n[patches.p]\nkind = \"blend\"\n{extra}\nconditions = [{{ u = 0, curve = \"c0\" }}, {{ u = 1, curve = \"c1\" }}]\n"
+    )
+}
+
+#[test]
+fn blend_with_a_vanishing_u_coefficient() {
+    fails(
+        &blend("orders = [2, 2, 2]\ncoefficients = [[0, 1], [1, 1], [1, 1]]"),
+        &["patches.p.coefficients[0]", "coefficient of ∂u^2 is zero"],
+    );
+}
+
+#[test]
+fn blend_with_an_unavailable_order_or_wrong_coefficient_count() {
+    fails(&blend("orders = [2, 3, 2]"), &["patches.p.orders[1]", "order 3 is not available"]);
+    fails(
+        &blend("orders = [2, 2, 4]\ncoefficients = [[1, 1], [1, 1], [1, 1]]"),
+        &["patches.p.coefficients[2]", "takes 3 shape coefficients, 2 given"],
+    );
+}
+
+#[test]
+fn blend_missing_the_conditions_its_order_needs() {
+    fails(&blend("orders = [2, 2, 4]"), &["patches.p", "component z has order 4", "missing"]);
+}
+
+#[test]
+fn blend_keys_on_other_kinds_and_unknown_solver() {
+    fails(
+        &patch(r#"{ u = 0, curve = "c0" }, { u = 1, curve = "c1" }"#)
+            .replace("kind = \"hermite\"", "kind = \"hermite\"\norders = [2, 2, 2]"),
+        &["patches.p.orders", "only applies to kind = \"blend\""],
+    );
+    fails(&blend("orders = [2, 2, 2]\nsolver = \"magic\""), &["patches.p.solver", "unknown solver `magic`"]);
+}
+
+#[test]
+fn blend_exact_solver_on_data_it_cannot_take() {
+    let s = "[curves.c0]\nexpr = [\"cos(v)\", \"sin(v)\", \"1/(1.02 + cos(v))\"]\n[curves.c1]\nexpr = [\"cos(v)\", \"sin(v)\", \"1\"]\n\
+         [patches.p]\nkind = \"blend\"\norders = [2, 2, 2]\nsolver = \"exact\"\n\
+         conditions = [{ u = 0, curve = \"c0\" }, { u = 1, curve = \"c1\" }]\n";
+    fails(s, &["patches.p", "exact solver needs eigenfunctions", "component z"]);
+}

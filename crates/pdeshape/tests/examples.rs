@@ -30,7 +30,10 @@ fn every_example_builds_and_meets_its_conditions() {
         let mut small = scene;
         small.render.size = (64, 48);
         let img = model::render_scene(&small).unwrap();
-        assert_eq!(img.data.len(), 64 * 48 * 4);
+        // one 64 × 48 picture, or a strip of panels for an order study of blends
+        assert!(img.width >= 64 && img.height >= 48, "{}: {} × {}", path.display(), img.width, img.height);
+        assert_eq!(img.data.len(), (img.width * img.height * 4) as usize);
+        assert!(img.data.chunks(4).any(|px| px[..3] != img.data[..3]), "{}: a blank picture", path.display());
     }
     assert!(n >= 3, "only {n} examples found");
 }

@@ -5,6 +5,7 @@ use super::raw::*;
 use super::{Param, PatchKind, RenderSettings, Scene, ScenePatch, SceneSurface};
 use indexmap::IndexMap;
 use pdeshape_core::Vec3;
+use pdeshape_core::blend::{BasisFn, BlendOptions, Operator, Solver, StaticBlend};
 use pdeshape_core::data::{BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative};
 use pdeshape_core::expr::{BinOp, Expr, ExprError, Func, Node};
 use pdeshape_core::patch::{Condition, HermitePatch, VDomain};
@@ -29,6 +30,8 @@ type R<T> = Result<T, SceneError>;
 struct Ctx<'a> {
     src: Source<'a>,
     params: IndexMap<String, Param>,
+    /// Solver override for patches that offer a choice.
+    solver: Option<Solver>,
 }
 
 fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
@@ -530,9 +533,16 @@ impl CurveBuilder<'_, '_> {
     }
 }
 
-pub(super) fn build(src: Source, name: &str, overrides: &HashMap<String, f64>) -> R<Scene> {
+pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Scene> {
+    let overrides = &opts.params;
     let raw: RawScene = toml::from_str(src.text).map_err(|e| toml_error(&src, e))?;
-    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new() };
+    let solver = match opts.solver.as_deref() {
+        None => None,
+        Some(w) => Some(Solver::parse(w).ok_or_else(|| {
+            src.error(None, "--solver", format!("unknown solver `{w}` (known: auto, exact, collocation)"))
+        })?),
+    };
+    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver };
     let mut taken: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.parameters {
         check_name(&src, n, span(p), &format!("parameters.{n}"), &mut taken)?;
@@ -645,36 +655,50 @@ fn build_patch(
     let kind = match rp.kind.get_ref().as_str() {
         "hermite" => PatchKind::Hermite,
         "pde" => PatchKind::Pde,
-        k @ ("blend" | "dynamic" | "solid") => {
+        "blend" => PatchKind::Blend,
+        k @ ("dynamic" | "solid") => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde)"),
+                format!(
+                    "patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde, blend)"
+                ),
             ));
         }
         k => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("unknown patch kind `{k}` (known: hermite, pde)"),
+                format!("unknown patch kind `{k}` (known: hermite, pde, blend)"),
             ));
         }
     };
-    if kind != PatchKind::Pde {
-        for (present, name) in [(rp.a.is_some(), "a"), (rp.modes.is_some(), "modes"), (rp.omega.is_some(), "omega")] {
-            if present {
-                return Err(ctx.err(
-                    span(p),
-                    format!("{key}.{name}"),
-                    format!("`{name}` only applies to kind = \"pde\""),
-                ));
-            }
+    let only = |present: bool, name: &str, for_kind: PatchKind| -> R<()> {
+        if present && kind != for_kind {
+            return Err(ctx.err(
+                span(p),
+                format!("{key}.{name}"),
+                format!("`{name}` only applies to kind = \"{}\"", for_kind.name()),
+            ));
         }
-    }
+        Ok(())
+    };
+    only(rp.a.is_some(), "a", PatchKind::Pde)?;
+    only(rp.modes.is_some(), "modes", PatchKind::Pde)?;
+    only(rp.omega.is_some(), "omega", PatchKind::Pde)?;
+    only(rp.sections.is_some() && kind == PatchKind::Blend, "sections", PatchKind::Pde)?;
+    only(rp.orders.is_some(), "orders", PatchKind::Blend)?;
+    only(rp.coefficients.is_some(), "coefficients", PatchKind::Blend)?;
+    only(rp.solver.is_some(), "solver", PatchKind::Blend)?;
+    only(rp.bubbles.is_some(), "bubbles", PatchKind::Blend)?;
+    only(rp.collocation.is_some(), "collocation", PatchKind::Blend)?;
+    only(rp.basis.is_some(), "basis", PatchKind::Blend)?;
+    only(rp.start.is_some(), "start", PatchKind::Blend)?;
+    only(rp.end.is_some(), "end", PatchKind::Blend)?;
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;
-    if rp.conditions.is_none() && rp.sections.is_none() {
-        return Err(ctx.err(span(p), &key, "the patch has no `conditions` (and no `sections`)"));
+    if rp.conditions.is_none() && rp.sections.is_none() && rp.start.is_none() && rp.end.is_none() {
+        return Err(ctx.err(span(p), &key, "the patch has no `conditions` (and no `sections`, `start` or `end`)"));
     }
     let no_conds = Vec::new();
     let rconds_list = rp.conditions.as_ref().map(|c| c.get_ref()).unwrap_or(&no_conds);
@@ -685,6 +709,36 @@ fn build_patch(
         let (c, fam) = build_sections(ctx, sec, domain, &format!("{key}.sections"))?;
         conditions.extend(c);
         sections = fam;
+    }
+    for (end_u, end, name) in [(0.0, &rp.start, "start"), (1.0, &rp.end, "end")] {
+        let Some(e) = end else { continue };
+        let ek = format!("{key}.{name}");
+        let re = e.get_ref();
+        let surf = surfaces.iter().find(|s| s.name == *re.surface.get_ref()).ok_or_else(|| {
+            ctx.err(
+                span(&re.surface),
+                format!("{ek}.surface"),
+                format!(
+                    "unknown surface `{}` (defined: {})",
+                    re.surface.get_ref(),
+                    if surfaces.is_empty() {
+                        "none".to_string()
+                    } else {
+                        surfaces.iter().map(|s| s.name.clone()).collect::<Vec<_>>().join(", ")
+                    }
+                ),
+            )
+        })?;
+        let s0 = ctx.num(re.s.get_ref(), span(&re.s), &format!("{ek}.s"))?;
+        let scale = match &re.scale {
+            Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ek}.scale"))?,
+            None => 1.0,
+        };
+        for order in 0..=2 {
+            let data: FieldRef = Arc::new(Trimline::new(surf.field.clone(), s0, order, scale));
+            check_data(ctx, &data, domain, span(e), &format!("{ek} (order {order})"))?;
+            conditions.push(Condition { u: end_u, order, data });
+        }
     }
     for (i, rc) in rconds_list.iter().enumerate() {
         let ck = format!("{key}.conditions[{i}]");
@@ -741,9 +795,17 @@ fn build_patch(
             Arc::new(Trimline::new(surf.field.clone(), s0, order, scale))
         };
         check_data(ctx, &data, domain, span(rc), &ck)?;
+        if kind == PatchKind::Blend && conditions.iter().any(|o| o.u == u && o.order == order) {
+            return Err(ctx.err(
+                span(rc),
+                &ck,
+                format!("∂^{order}X/∂u^{order} at u = {u} is already given (by `start`/`end` or another condition)"),
+            ));
+        }
         conditions.push(Condition { u, order, data });
     }
     let mut spectral = None;
+    let mut blend = None;
     let surface: Arc<dyn pdeshape_core::patch::Surface> = match kind {
         PatchKind::Hermite => Arc::new(
             HermitePatch::new(&conditions, domain)
@@ -766,9 +828,113 @@ fn build_patch(
             spectral = Some(sp.clone());
             sp
         }
+        PatchKind::Blend => {
+            let setup = build_blend(ctx, &key, p, &conditions, domain, conds_span.clone())?;
+            let b = setup.blend.clone();
+            blend = Some(setup);
+            b
+        }
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral, sections })
+    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral, sections, blend })
+}
+
+/// Operators, options and the solve of a static blend (SPEC §4).
+fn build_blend(
+    ctx: &Ctx,
+    key: &str,
+    p: &Spanned<RawPatch>,
+    conditions: &[Condition],
+    domain: VDomain,
+    conds_span: Option<Range<usize>>,
+) -> R<super::BlendSetup> {
+    let rp = p.get_ref();
+    let orders: [usize; 3] = match &rp.orders {
+        None => [4, 4, 4],
+        Some(o) => {
+            let mut out = [0; 3];
+            for (t, &x) in o.get_ref().iter().enumerate() {
+                if ![2, 4, 6].contains(&x) {
+                    return Err(ctx.err(
+                        span(o),
+                        format!("{key}.orders[{t}]"),
+                        format!("order {x} is not available (static blends have order 2, 4 or 6 per component)"),
+                    ));
+                }
+                out[t] = x as usize;
+            }
+            out
+        }
+    };
+    let mut ops = Vec::with_capacity(3);
+    for t in 0..3 {
+        let r = orders[t] / 2;
+        let op = match &rp.coefficients {
+            None => Operator::laplacian_power(r),
+            Some(c) => {
+                let list = &c.get_ref()[t];
+                let ck = format!("{key}.coefficients[{t}]");
+                if list.len() != r + 1 {
+                    return Err(ctx.err(
+                        span(c),
+                        &ck,
+                        format!(
+                            "component {} has order {}: it takes {} shape coefficients, {} given",
+                            ["x", "y", "z"][t],
+                            2 * r,
+                            r + 1,
+                            list.len()
+                        ),
+                    ));
+                }
+                let vals = list.iter().map(|x| ctx.num(x, span(c), &ck)).collect::<R<Vec<f64>>>()?;
+                Operator::new(vals).map_err(|e| ctx.err(span(c), &ck, e.to_string()))?
+            }
+        };
+        ops.push(op);
+    }
+    let ops: [Operator; 3] = ops.try_into().expect("three operators");
+    let mut options = BlendOptions::default();
+    if let Some(sv) = &rp.solver {
+        options.solver = Solver::parse(sv.get_ref()).ok_or_else(|| {
+            ctx.err(
+                span(sv),
+                format!("{key}.solver"),
+                format!("unknown solver `{}` (known: auto, exact, collocation)", sv.get_ref()),
+            )
+        })?;
+    }
+    if let Some(s) = ctx.solver {
+        options.solver = s;
+    }
+    if let Some(b) = &rp.bubbles {
+        options.bubbles = ctx.int(b, 1, 40, &format!("{key}.bubbles"))? as usize;
+    }
+    if let Some(c) = &rp.collocation {
+        let [l, q] = *c.get_ref();
+        if !(1..=400).contains(&l) || !(1..=400).contains(&q) {
+            return Err(ctx.err(
+                span(c),
+                format!("{key}.collocation"),
+                format!("[{l}, {q}] is out of range (1 … 400)"),
+            ));
+        }
+        options.collocation = Some((l as usize, q as usize));
+    }
+    if let Some(list) = &rp.basis {
+        let mut basis = Vec::new();
+        for (j, t) in list.get_ref().iter().enumerate() {
+            let text = t.get_ref();
+            let bk = format!("{key}.basis[{j}]");
+            let e = Expr::parse(text).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
+            let e = e.bind(&["v"], &ctx.param_lookup()).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
+            basis.push(BasisFn::Expr { expr: e, text: text.clone() });
+        }
+        options.basis = Some(basis);
+    }
+    let blend = StaticBlend::new(ops, conditions, domain, &options)
+        .map_err(|e| ctx.err(conds_span.or(Some(p.span())), key, e.to_string()))?;
+    Ok(super::BlendSetup { blend: Arc::new(blend), options })
 }
 
 /// Expands `[patches.NAME.sections]` into position conditions.

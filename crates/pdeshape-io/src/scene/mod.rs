@@ -55,6 +55,15 @@ pub struct SceneSurface {
     pub resolution: (usize, usize),
 }
 
+/// Overrides applied while a scene is resolved.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// Parameter values by name.
+    pub params: HashMap<String, f64>,
+    /// Solver for patches that offer a choice (blends).
+    pub solver: Option<String>,
+}
+
 /// What a patch is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PatchKind {
@@ -62,6 +71,8 @@ pub enum PatchKind {
     Hermite,
     /// `(∂u² + a²∂v²)^N X = 0` by the spectral method (SPEC §3).
     Pde,
+    /// A static blend of 2nd, 4th, 6th or mixed order (SPEC §4).
+    Blend,
 }
 
 impl PatchKind {
@@ -70,6 +81,7 @@ impl PatchKind {
         match self {
             PatchKind::Hermite => "hermite",
             PatchKind::Pde => "pde",
+            PatchKind::Blend => "blend",
         }
     }
 }
@@ -93,6 +105,17 @@ pub struct ScenePatch {
     pub spectral: Option<Arc<SpectralPatch>>,
     /// The section family the patch interpolates, when it was given by `sections`.
     pub sections: Option<SectionFamily>,
+    /// The static blend and the options it was solved with, for blend patches.
+    pub blend: Option<BlendSetup>,
+}
+
+/// A solved static blend with what is needed to solve it again another way.
+#[derive(Clone, Debug)]
+pub struct BlendSetup {
+    /// The solution.
+    pub blend: Arc<pdeshape_core::blend::StaticBlend>,
+    /// The options it was solved with.
+    pub options: pdeshape_core::blend::BlendOptions,
 }
 
 /// A family of cross sections `C(v; s)` placed at `(u_i, s_i)`, against which `check`
@@ -238,7 +261,13 @@ impl Scene {
     /// Parses scene text. `overrides` replace parameter values (by name) before anything
     /// is resolved — the live editor's sliders.
     pub fn parse(text: &str, file: &str, name: &str, overrides: &HashMap<String, f64>) -> Result<Scene, SceneError> {
-        build::build(Source { file, text }, name, overrides)
+        build::build(Source { file, text }, name, &LoadOptions { params: overrides.clone(), solver: None })
+    }
+
+    /// Parses scene text with parameter overrides and a solver override for every patch
+    /// that offers a choice of solver (blends: `auto`, `exact`, `collocation`).
+    pub fn parse_with(text: &str, file: &str, name: &str, opts: &LoadOptions) -> Result<Scene, SceneError> {
+        build::build(Source { file, text }, name, opts)
     }
 
     /// The patch with the given name.

@@ -137,6 +137,34 @@ pub struct RawPatch {
     pub omega: Option<Spanned<NumOrExpr>>,
     /// A family of position conditions (cross sections).
     pub sections: Option<Spanned<RawSections>>,
+    /// Blends: operator order per component `[x, y, z]` (2, 4 or 6).
+    pub orders: Option<Spanned<[i64; 3]>>,
+    /// Blends: shape coefficients per component (`r + 1` numbers for order `2r`).
+    pub coefficients: Option<Spanned<[Vec<NumOrExpr>; 3]>>,
+    /// Blends: `"auto"`, `"exact"` or `"collocation"`.
+    pub solver: Option<Spanned<String>>,
+    /// Blends: bubble functions per basis function (collocation).
+    pub bubbles: Option<Spanned<i64>>,
+    /// Blends: collocation grid `[L, Q]`.
+    pub collocation: Option<Spanned<[i64; 2]>>,
+    /// Blends: explicit boundary basis functions `g_j(v)`.
+    pub basis: Option<Spanned<Vec<Spanned<String>>>>,
+    /// Blends: the primary surface at `u = 0` (conditions of orders 0, 1, 2 from its trimline).
+    pub start: Option<Spanned<RawEnd>>,
+    /// Blends: the primary surface at `u = 1`.
+    pub end: Option<Spanned<RawEnd>>,
+}
+
+/// A blend end: a trimline of a primary surface.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawEnd {
+    /// The primary surface.
+    pub surface: Spanned<String>,
+    /// The trimline `s = s₀`.
+    pub s: Spanned<NumOrExpr>,
+    /// `ds/du` (default 1).
+    pub scale: Option<Spanned<NumOrExpr>>,
 }
 
 /// `[patches.NAME.sections]`: `count` position conditions `X(u_i, v) = C(v; s_i)`.

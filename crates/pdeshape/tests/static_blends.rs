@@ -1,0 +1,120 @@
+//! Static blends of 2nd, 4th, 6th and mixed order (SPEC §4) through the scene files, the
+//! diagnostics and the CLI.
+
+use assert_cmd::Command;
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
+}
+
+/// The paper's conclusion in numbers: 2nd order and every mix with a 2nd-order component
+/// are C0 only; 4th order (and 4 + 6) are C1 with G1 angles at round-off; 6th order is C2.
+#[test]
+fn continuity_table_of_the_cone_cylinder_blends() {
+    let scene = Scene::load(&example("blend-cone-cylinder.toml")).unwrap();
+    let want = [("o2", "C0"), ("o2-4", "C0"), ("o2-6", "C0"), ("o4", "C1"), ("o4-6", "C1"), ("o6", "C2")];
+    assert_eq!(scene.patches.len(), 6);
+    for (p, (name, class)) in scene.patches.iter().zip(want) {
+        assert_eq!(p.name, name);
+        let d = model::patch_diagnostics(p);
+        assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10, "{name}: {}", d["condition_error"]);
+        assert_eq!(d["continuity"]["class"], class, "{name}: {}", d["continuity"]);
+        assert_eq!(d["solver"], "exact");
+        let dist = d["blend"]["exact_vs_collocation_max_distance"].as_f64().unwrap();
+        assert!(dist < 1e-9, "{name}: exact vs collocation {dist}");
+        for end in ["start", "end"] {
+            let g1 = d["continuity"][end]["g1_radians"].as_f64().unwrap();
+            if class == "C0" {
+                assert!(g1 > 1e-2, "{name}: a blend with a 2nd-order component has a crease ({g1} rad)");
+            } else {
+                assert!(g1 <= 1e-8, "{name}: G1 angle {g1}");
+            }
+            let c2 = d["continuity"][end]["c2"].as_f64().unwrap();
+            assert_eq!(c2 <= 1e-8, class == "C2", "{name}: C2 gap {c2}");
+        }
+    }
+}
+
+#[test]
+fn torus_hyperboloid_blends_and_per_vertex_continuity_fields() {
+    let scene = Scene::load(&example("blend-torus-hyperboloid.toml")).unwrap();
+    let classes: Vec<String> = scene
+        .patches
+        .iter()
+        .map(|p| model::patch_diagnostics(p)["continuity"]["class"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(classes, ["C0", "C2"]);
+    let m = model::patch_mesh(&scene.patches[1]).unwrap();
+    let names: Vec<&str> = m.fields.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["c0_gap", "c1_gap", "g1_angle", "c2_gap", "g2_gap"]);
+    assert!(m.fields.iter().all(|f| f.values.len() == m.positions.len() && f.values.iter().all(|x| *x < 1e-10)));
+    let m = model::patch_mesh(&scene.patches[0]).unwrap();
+    assert!(m.fields[2].values.iter().fold(0.0f64, |a, b| a.max(*b)) > 0.1, "the 2nd-order blend creases");
+}
+
+/// `--solver` overrides the scene: both solvers through `sample` agree on eigenfunction
+/// data, and `check` says which ran.
+#[test]
+fn solver_override_in_sample_and_check() {
+    let input: String = (0..50).map(|i| format!("{},{}\n", (i as f64 * 0.618) % 1.0, i as f64 * 0.37)).collect();
+    let run = |solver: &str| -> Vec<Vec<f64>> {
+        let out = Command::cargo_bin("pdeshape")
+            .unwrap()
+            .args(["sample", "--patch", "o4", "--solver", solver])
+            .arg(example("blend-cone-cylinder.toml"))
+            .write_stdin(input.clone())
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        String::from_utf8(out)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let (a, b) = (run("exact"), run("collocation"));
+    assert_eq!(a.len(), 50);
+    for (x, y) in a.iter().zip(&b) {
+        for k in 2..5 {
+            assert!((x[k] - y[k]).abs() < 1e-9, "{x:?} vs {y:?}");
+        }
+    }
+    let out = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["check", "--json", "--solver", "collocation"])
+        .arg(example("blend-torus-hyperboloid.toml"))
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let d: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(d["patches"][1]["solver"], "collocation");
+    assert!(d["patches"][1]["blend"]["components"][0]["collocation_rms_residual"].as_f64().is_some());
+    let a = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["check", "--solver", "magic"])
+        .arg(example("blend-torus-hyperboloid.toml"))
+        .assert()
+        .code(1);
+    assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("unknown solver `magic`"));
+}
+
+#[test]
+fn overriding_coefficients_by_parameters_keeps_exactness() {
+    let text = std::fs::read_to_string(example("blend-torus-hyperboloid.toml")).unwrap().replace(
+        "orders = [6, 6, 6]",
+        "orders = [6, 6, 6]\ncoefficients = [[1, 0.5, 2, 0.7], [2, 1, 1, 1], [1, 3, 3, 1]]",
+    );
+    let scene = Scene::parse(&text, "t.toml", "t", &HashMap::new()).unwrap();
+    let d = model::patch_diagnostics(&scene.patches[1]);
+    assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10);
+    assert_eq!(d["continuity"]["class"], "C2");
+}
