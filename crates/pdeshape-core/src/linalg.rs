@@ -75,6 +75,29 @@ pub fn least_squares(a: &Mat<f64>, b: &Mat<f64>, max_cond: f64) -> Result<(Mat<f
     Ok((qr.solve_lstsq(b), cond))
 }
 
+/// Minimum-norm least squares `min ‖A x − B‖` by the thin SVD, dropping singular values
+/// below `rcond · σ_max`: the right answer when `A` is rank deficient but every solution
+/// gives the same fit (e.g. basis functions that coincide at one instant). Returns the
+/// solution and the numerical rank.
+pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<(Mat<f64>, usize), LinalgError> {
+    if !(0..a.nrows()).all(|i| (0..a.ncols()).all(|j| a[(i, j)].is_finite())) {
+        return Err(LinalgError::NonFinite);
+    }
+    let svd = a.thin_svd().map_err(|_| LinalgError::NoConvergence)?;
+    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+    let smax = (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
+    let mut utb = u.transpose() * b;
+    let mut rank = 0;
+    for i in 0..s.nrows() {
+        let keep = s[i] > rcond * smax && s[i] > 0.0;
+        rank += usize::from(keep);
+        for c in 0..b.ncols() {
+            utb[(i, c)] = if keep { utb[(i, c)] / s[i] } else { 0.0 };
+        }
+    }
+    Ok((v * utb, rank))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,6 +113,12 @@ mod tests {
         assert!((s.cond() - 3.0 / 1.5).abs() < 1e-12);
         let sing = Mat::from_fn(2, 2, |_, _| 1.0);
         assert!(matches!(SquareSolver::new(&sing, 1e12), Err(LinalgError::Singular { .. })));
+        // rank-deficient least squares: two equal columns share the fit equally
+        let a = Mat::from_fn(3, 2, |i, _| (i + 1) as f64);
+        let b = Mat::from_fn(3, 1, |i, _| 2.0 * (i + 1) as f64);
+        let (x, rank) = least_squares_min_norm(&a, &b, 1e-12).unwrap();
+        assert_eq!(rank, 1);
+        assert!((x[(0, 0)] - 1.0).abs() < 1e-14 && (x[(1, 0)] - 1.0).abs() < 1e-14);
     }
 
     #[test]

@@ -12,16 +12,20 @@
 //!   ([`Solver::Collocation`], [`bubbles`]).
 //!
 //! [`continuity`] measures what each order achieves at the trimlines: C0, C1, G1, C2, G2.
+//!
+//! [`DynamicBlend`] is the time-dependent C1 blend of SPEC §5 (paper 002).
 
 mod basis;
 mod bubble;
 mod continuity;
+mod dynamic;
 mod operator;
 mod solve;
 
 pub use basis::{BasisFn, Decomposition, MAX_SPLIT_MODES, decompose};
 pub use bubble::bubbles;
 pub use continuity::{Gaps, continuity, gaps_at};
+pub use dynamic::{DynBasis, DynamicBlend, DynamicFrame, DynamicOperator, DynamicOptions, DynamicReport, zeta};
 pub use operator::Operator;
 pub use solve::{BlendOptions, ComponentReport, Solver, StaticBlend};
 

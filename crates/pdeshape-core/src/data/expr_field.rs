@@ -58,6 +58,9 @@ impl Field for ExprField {
     fn arity(&self) -> usize {
         self.vars.len()
     }
+    fn expressions(&self) -> Option<(&[Expr; 3], &[String])> {
+        Some((&self.comps, &self.vars))
+    }
 
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
         let vars: Vec<Jet> = (0..self.vars.len()).map(|i| Jet::variable(shape, i, at[i])).collect();

@@ -85,6 +85,12 @@ pub trait Field: Send + Sync + Debug {
     fn is_constant_in(&self, _slot: usize) -> bool {
         false
     }
+
+    /// The component expressions with their variable names, for fields defined by
+    /// expressions (used to expand boundary data into basis functions, SPEC §5).
+    fn expressions(&self) -> Option<(&[crate::expr::Expr; 3], &[String])> {
+        None
+    }
 }
 
 /// A shared, type-erased field.
