@@ -28,8 +28,48 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     if let Some(b) = &p.blend {
         add_continuity_fields(&mut m, p, b.blend.as_ref());
     }
+    if let Some(d) = &p.dynamic {
+        m.animation = Some(dynamic_animation(p, d, nu, nv)?);
+    }
     m.check_finite()?;
     Ok(m)
+}
+
+/// The frames of a dynamic blend as morph targets: positions and normals of the same grid
+/// at every frame time.
+fn dynamic_animation(
+    p: &ScenePatch,
+    d: &crate::scene::DynamicSetup,
+    nu: usize,
+    nv: usize,
+) -> Result<pdeshape_core::mesh::MorphAnimation, String> {
+    let times = d.frame_times();
+    let mut anim = pdeshape_core::mesh::MorphAnimation { times: times.clone(), positions: vec![], normals: vec![] };
+    for &t in &times {
+        let f = d.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+        let fm = grid_mesh(&f, &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+        anim.positions.push(fm.positions);
+        anim.normals.push(fm.normals);
+    }
+    Ok(anim)
+}
+
+/// The frame meshes of a dynamic patch (`None` for other patches), named `PATCH-NNN`.
+pub fn frame_meshes(p: &ScenePatch) -> Option<Result<Vec<Mesh>, String>> {
+    let d = p.dynamic.as_ref()?;
+    let (nu, nv) = p.resolution;
+    let run = || -> Result<Vec<Mesh>, String> {
+        let mut out = Vec::new();
+        for (i, t) in d.frame_times().into_iter().enumerate() {
+            let f = d.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+            let mut m = grid_mesh(&f, &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
+            m.name = format!("{}-{i:03}", p.name);
+            m.check_finite()?;
+            out.push(m);
+        }
+        Ok(out)
+    };
+    Some(run())
 }
 
 /// The trimline data `∂ᵏS/∂uᵏ`, `k = 0, 1, 2`, at the blend end `u_e`, from the patch's
@@ -77,10 +117,15 @@ pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
 
 /// Meshes of the primary surfaces drawn in context (those with an `s_range`).
 pub fn context_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
+    context_meshes_at(scene, 0.0)
+}
+
+/// The context surfaces at time `t` (moving primary surfaces of dynamic blends).
+pub fn context_meshes_at(scene: &Scene, t: f64) -> Result<Vec<Mesh>, String> {
     let mut out = Vec::new();
     for s in &scene.surfaces {
         let Some(range) = s.s_range else { continue };
-        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, 0.0);
+        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, t);
         let mut m = grid_mesh(&ps, &GridOptions::new(s.resolution.0, s.resolution.1))
             .map_err(|e| format!("surface `{}`: {e}", s.name))?;
         m.name = format!("surface-{}", s.name);
@@ -108,6 +153,9 @@ pub fn render_meshes(patches: &[Mesh], context: &[Mesh], colors: &[Option<[f64; 
 /// order study) becomes a strip with one panel per blend ([`blend_strip`]).
 pub fn render_scene(scene: &Scene) -> Result<Image, String> {
     if let Some(strip) = blend_strip(scene) {
+        return strip;
+    }
+    if let Some(strip) = dynamic_strip(scene) {
         return strip;
     }
     let patches = patch_meshes(scene)?;
@@ -164,6 +212,50 @@ pub fn blend_strip(scene: &Scene) -> Option<Result<Image, String>> {
     Some(run())
 }
 
+/// For scenes with a dynamic blend: one panel per frame time (patches and moving primary
+/// surfaces at that time), captioned with the time.
+pub fn dynamic_strip(scene: &Scene) -> Option<Result<Image, String>> {
+    let d = scene.patches.iter().find_map(|p| p.dynamic.as_ref())?;
+    let run = || -> Result<Image, String> {
+        let times = d.frame_times();
+        let mut r = scene.render.clone();
+        let w = (scene.render.size.0 * 3 / times.len().max(3) as u32).clamp(64, 400);
+        r.size = (w, w * 4 / 3);
+        let mut panels = Vec::new();
+        for &t in &times {
+            let context = context_meshes_at(scene, t)?;
+            let mut meshes = Vec::new();
+            for p in &scene.patches {
+                match &p.dynamic {
+                    Some(dy) => {
+                        let f = dy.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+                        let mut m = grid_mesh(&f, &GridOptions::new(p.resolution.0, p.resolution.1))
+                            .map_err(|e| format!("patch `{}`: {e}", p.name))?;
+                        m.name = p.name.clone();
+                        meshes.push(m);
+                    }
+                    None => meshes.push(patch_mesh(p)?),
+                }
+            }
+            let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
+            let img = render_meshes(&meshes, &context, &colors, &r);
+            let mut panel = Image::new(img.width, img.height + 34, [255, 255, 255]);
+            panel.paste(&img, 0, 0);
+            crate::render::draw_text(
+                &mut panel,
+                10.0,
+                img.height as f32 + 4.0,
+                22.0,
+                &format!("t = {t:.2}"),
+                [30, 30, 40],
+            );
+            panels.push(panel);
+        }
+        Ok(Image::strip(&panels, 4, [255, 255, 255]))
+    };
+    Some(run())
+}
+
 fn palette(k: usize) -> [f64; 3] {
     PALETTE[k % PALETTE.len()].map(f64::from)
 }
@@ -178,6 +270,43 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     if let Some(b) = &p.blend {
         rep = blend_condition_report(b.blend.as_ref(), &p.conditions);
     }
+    let mut dyn_json = Value::Null;
+    if let Some(dy) = &p.dynamic {
+        // every frame against the data at its own time
+        let mut frames = Vec::new();
+        let mut worst = pdeshape_core::patch::ConditionReport { max_abs: 0.0, max_rel: 0.0, size: 0.0 };
+        let mut report = None;
+        for t in dy.frame_times() {
+            match dy.blend.frame(t) {
+                Ok(f) => {
+                    let r = check_conditions(&f, &p.conditions, t, CHECK_SAMPLES);
+                    frames.push(json!({"t": t, "max_abs": r.max_abs, "max_rel": r.max_rel}));
+                    if r.max_rel >= worst.max_rel {
+                        worst = r;
+                    }
+                    report.get_or_insert_with(|| f.report().clone());
+                }
+                Err(e) => frames.push(json!({"t": t, "error": e.to_string()})),
+            }
+        }
+        rep = worst;
+        let op = dy.blend.operator();
+        let r = report.unwrap_or_else(|| pdeshape_core::blend::DynamicReport {
+            solver: "none",
+            basis: vec![],
+            exact_available: false,
+            condition_number: f64::NAN,
+        });
+        dyn_json = json!({
+            "operator": {"beta": op.beta, "gamma": op.gamma, "lambda": op.lambda, "rho": op.rho, "eta": op.eta},
+            "solver": r.solver,
+            "exact_available": r.exact_available,
+            "basis": r.basis,
+            "condition_number": r.condition_number,
+            "time": [dy.times.0, dy.times.1],
+            "frames": frames,
+        });
+    }
     let dom = p.surface.v_domain();
     let mut d = json!({
         "name": p.name,
@@ -186,7 +315,7 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             (crate::scene::PatchKind::Hermite, _) => "hermite-interpolation".to_string(),
             (crate::scene::PatchKind::Pde, _) => "spectral".to_string(),
             (_, Some(b)) => blend_solver_name(b.blend.as_ref()),
-            (_, None) => "none".to_string(),
+            (_, None) => p.dynamic.as_ref().and_then(|d| d.blend.frame(d.times.0).ok()).map(|f| f.report().solver.to_string()).unwrap_or_else(|| "none".into()),
         },
         "conditions": p.conditions.iter().map(|c| json!({"u": c.u, "order": c.order})).collect::<Vec<_>>(),
         "v_domain": {"start": dom.start, "end": dom.end, "periodic": dom.periodic},
@@ -225,6 +354,9 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     }
     if let Some(b) = &p.blend {
         blend_diagnostics(p, b, &mut d, rep.size);
+    }
+    if !dyn_json.is_null() {
+        d["dynamic"] = dyn_json;
     }
     if let Some(sp) = &p.spectral {
         let r = sp.report();

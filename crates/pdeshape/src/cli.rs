@@ -63,6 +63,9 @@ enum Command {
         /// Solver for blends: auto, exact or collocation (overrides the scene).
         #[arg(long)]
         solver: Option<String>,
+        /// Sine terms K of a dynamic blend's collocation solver (overrides the scene).
+        #[arg(long)]
+        terms: Option<usize>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
@@ -146,10 +149,15 @@ pub fn load(path: &Path, set: &[String]) -> Result<Scene> {
 
 /// Loads a scene with parameter overrides and an optional solver override.
 pub fn load_with(path: &Path, set: &[String], solver: Option<&str>) -> Result<Scene> {
+    load_opts(path, set, solver, None)
+}
+
+/// Loads a scene with parameter, solver and sine-term overrides.
+pub fn load_opts(path: &Path, set: &[String], solver: Option<&str>, terms: Option<usize>) -> Result<Scene> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {}", path.display()))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string) };
+    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string), terms };
     Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
 }
 
@@ -190,7 +198,7 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for f in &scene.formats {
         if f == "png" {
-            let img = match model::blend_strip(scene) {
+            let img = match model::blend_strip(scene).or_else(|| model::dynamic_strip(scene)) {
                 Some(strip) => strip.map_err(|e| anyhow!(e))?,
                 None => {
                     let context = model::context_meshes(scene).map_err(|e| anyhow!(e))?;
@@ -208,6 +216,16 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
             let path = dir.join(format!("{}-{}.{}", scene.name, m.name, fmt.extension()));
             write_meshes(&path, fmt, &[m]).with_context(|| format!("cannot write {}", path.display()))?;
             written.push(path);
+        }
+    }
+    // dynamic blends: a numbered frame sequence beside the animated glTF
+    for p in &scene.patches {
+        if let Some(frames) = model::frame_meshes(p) {
+            for m in frames.map_err(|e| anyhow!(e))? {
+                let path = dir.join(format!("{}-{}.obj", scene.name, m.name));
+                write_meshes(&path, Format::Obj, &[&m]).with_context(|| format!("cannot write {}", path.display()))?;
+                written.push(path);
+            }
         }
     }
     Ok(written)
@@ -330,8 +348,11 @@ fn execute(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Sample { scene, patch, time, set, solver } => {
-            let sc = load_with(&scene, &set, solver.as_deref())?;
+        Command::Sample { scene, patch, time, set, solver, terms } => {
+            if terms == Some(0) {
+                bail!("--terms 0: at least one sine term is needed");
+            }
+            let sc = load_opts(&scene, &set, solver.as_deref(), terms)?;
             let p = match &patch {
                 Some(n) => sc.patch(n).ok_or_else(|| {
                     anyhow!(
@@ -346,11 +367,17 @@ fn execute(cli: Cli) -> Result<()> {
                 if !t.is_finite() {
                     bail!("--time {t} is not finite");
                 }
-                if t != 0.0 && p.conditions.iter().all(|c| c.data.is_constant_in(1)) {
-                    eprintln!("note: patch `{}` does not depend on time", p.name);
+                if t != 0.0 && p.dynamic.is_none() && !cli.quiet {
+                    eprintln!("note: patch `{}` is not a dynamic blend: --time does not change it", p.name);
                 }
             }
-            sample(p, time.unwrap_or(0.0))
+            match (&p.dynamic, time) {
+                (Some(d), Some(t)) => {
+                    let f = d.blend.frame(t).map_err(|e| anyhow!("patch `{}` at t = {t}: {e}", p.name))?;
+                    sample(&f)
+                }
+                _ => sample(p.surface.as_ref()),
+            }
         }
         Command::Render { scene, out, width, height, azimuth, elevation, wireframe, set } => {
             let mut sc = load(&scene, &set)?;
@@ -384,12 +411,11 @@ fn execute(cli: Cli) -> Result<()> {
     }
 }
 
-fn sample(p: &pdeshape_io::scene::ScenePatch, t: f64) -> Result<()> {
-    let _ = t; // static patches ignore time; dynamic ones will use it
+fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {
     let stdin = std::io::stdin();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let dom = p.surface.v_domain();
+    let dom = surface.v_domain();
     writeln!(out, "u,v,x,y,z")?;
     for (ln, line) in stdin.lock().lines().enumerate() {
         let line = line.context("cannot read stdin")?;
@@ -418,7 +444,7 @@ fn sample(p: &pdeshape_io::scene::ScenePatch, t: f64) -> Result<()> {
         if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
             bail!("stdin line {}: v = {v} is outside [{}, {}]", ln + 1, dom.start, dom.end);
         }
-        let x = p.surface.point(u, v);
+        let x = surface.point(u, v);
         if !x.is_finite() {
             bail!("stdin line {}: the patch is not finite at (u, v) = ({u}, {v})", ln + 1);
         }

@@ -125,7 +125,9 @@ impl DynBasis {
     pub fn eigenvalues(&self, domain: VDomain, times: (f64, f64)) -> Option<(f64, f64)> {
         let pts: Vec<FDerivs> = (0..9)
             .flat_map(|i| {
-                (0..5).map(move |k| (domain.at((i as f64 + 0.31) / 9.2), times.0 + (times.1 - times.0) * (k as f64 + 0.17) / 4.5))
+                (0..5).map(move |k| {
+                    (domain.at((i as f64 + 0.31) / 9.2), times.0 + (times.1 - times.0) * (k as f64 + 0.17) / 4.5)
+                })
             })
             .map(|(v, t)| self.derivs(v, t))
             .collect();
@@ -136,7 +138,10 @@ impl DynBasis {
         let mu = pts.iter().map(|d| d.f * d.fvv).sum::<f64>() / den;
         let kappa = pts.iter().map(|d| d.f * d.ft).sum::<f64>() / den;
         let scale = pts.iter().fold(0.0f64, |m, d| {
-            m.max(d.fvv.abs()).max(d.ft.abs()).max(d.ftt.abs()).max(d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa))
+            m.max(d.fvv.abs())
+                .max(d.ft.abs())
+                .max(d.ftt.abs())
+                .max(d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa))
         });
         let tol = 1e-11 * scale;
         pts.iter()
@@ -264,7 +269,8 @@ fn extract(conds: &[&Condition]) -> (Vec<DynBasis>, Vec<Vec<Vec3>>) {
     for (ci, c) in conds.iter().enumerate() {
         for comp in 0..3 {
             let expanded = c.data.expressions().and_then(|(e, vars)| {
-                let vt = vars.len() <= 2 && vars.first().is_none_or(|v| v == "v") && vars.get(1).is_none_or(|v| v == "t");
+                let vt =
+                    vars.len() <= 2 && vars.first().is_none_or(|v| v == "v") && vars.get(1).is_none_or(|v| v == "t");
                 vt.then(|| expand(&e[comp]))
             });
             // printed terms name variables by slot: #0 is v, #1 is t
@@ -288,6 +294,14 @@ fn extract(conds: &[&Condition]) -> (Vec<DynBasis>, Vec<Vec<Vec3>>) {
                     }
                 }
                 None => {
+                    // identically zero components contribute nothing
+                    let zero = (0..23).all(|i| {
+                        let (v, t) = (0.27 * i as f64 + 0.05, 0.043 * i as f64);
+                        c.data.eval(&[v, t])[comp] == 0.0
+                    });
+                    if zero {
+                        continue;
+                    }
                     keys.push(None);
                     basis.push(DynBasis::Data {
                         field: c.data.clone(),
@@ -422,7 +436,13 @@ impl DynamicBlend {
         }
         let us: Vec<f64> = (0..nl).map(|l| l as f64 / (nl - 1) as f64).collect();
         let vs: Vec<f64> = (0..nm)
-            .map(|m| if self.domain.periodic { self.domain.at(m as f64 / nm as f64) } else { self.domain.at(m as f64 / (nm - 1).max(1) as f64) })
+            .map(|m| {
+                if self.domain.periodic {
+                    self.domain.at(m as f64 / nm as f64)
+                } else {
+                    self.domain.at(m as f64 / (nm - 1).max(1) as f64)
+                }
+            })
             .collect();
         let fd: Vec<Vec<FDerivs>> = vs.iter().map(|&v| self.basis.iter().map(|f| f.derivs(v, t)).collect()).collect();
         let z: Vec<Vec<[f64; 5]>> = us.iter().map(|&u| (1..=k).map(|kk| zeta(kk, u)).collect()).collect();
@@ -435,7 +455,8 @@ impl DynamicBlend {
         let rows = nl * nm;
         let mut cond: f64 = 0.0;
         let mut p = vec![vec![Vec3::ZERO; k]; nj];
-        let groups: Vec<Vec<usize>> = if self.opts.joint { vec![(0..nj).collect()] } else { (0..nj).map(|j| vec![j]).collect() };
+        let groups: Vec<Vec<usize>> =
+            if self.opts.joint { vec![(0..nj).collect()] } else { (0..nj).map(|j| vec![j]).collect() };
         for group in groups {
             let cols = group.len() * k;
             let mut a = Mat::<f64>::zeros(rows, cols);
@@ -466,7 +487,11 @@ impl DynamicBlend {
                 let (x, rank) = least_squares_min_norm(&a, &b, 1e-12).map_err(|e| {
                     BlendError::Solver(format!("the joint collocation fit ({rows} × {cols}) at t = {t} failed: {e}"))
                 })?;
-                cond = cond.max(if rank < cols { f64::INFINITY } else { crate::linalg::condition_number(&a).unwrap_or(f64::NAN) });
+                cond = cond.max(if rank < cols {
+                    f64::INFINITY
+                } else {
+                    crate::linalg::condition_number(&a).unwrap_or(f64::NAN)
+                });
                 x
             } else {
                 let (x, c) = least_squares(&a, &b, 1e17).map_err(|e| {
@@ -506,9 +531,16 @@ impl DynamicBlend {
 
 /// Coefficients of the four boundary functions over an explicit basis, by least squares
 /// on 31 × 7 points of `(v, t)`; data outside the span are an error.
-fn project(conds: &[&Condition], basis: &[DynBasis], domain: VDomain, times: (f64, f64)) -> Result<Vec<Vec<Vec3>>, BlendError> {
+fn project(
+    conds: &[&Condition],
+    basis: &[DynBasis],
+    domain: VDomain,
+    times: (f64, f64),
+) -> Result<Vec<Vec<Vec3>>, BlendError> {
     let pts: Vec<(f64, f64)> = (0..31)
-        .flat_map(|i| (0..7).map(move |k| (domain.at((i as f64 + 0.37) / 31.4), times.0 + (times.1 - times.0) * k as f64 / 6.0)))
+        .flat_map(|i| {
+            (0..7).map(move |k| (domain.at((i as f64 + 0.37) / 31.4), times.0 + (times.1 - times.0) * k as f64 / 6.0))
+        })
         .collect();
     let g = Mat::from_fn(pts.len(), basis.len(), |r, j| basis[j].partials(pts[r].0, pts[r].1, 0, 0)[0]);
     let mut out = Vec::new();
@@ -714,9 +746,11 @@ mod tests {
         let exact = DynamicBlend::new(op19(), &conds, VDomain::PERIODIC, &DynamicOptions::default()).unwrap();
         let fe = exact.frame(0.0).unwrap();
         let names: Vec<String> = exact.basis().iter().map(|f| f.name()).collect();
-        let j1 = names.iter().position(|n| n == "exp(t)*sin(v)").unwrap_or_else(|| panic!("F_1 = e^t sin v in {names:?}"));
+        let j1 =
+            names.iter().position(|n| n == "exp(t)*sin(v)").unwrap_or_else(|| panic!("F_1 = e^t sin v in {names:?}"));
         let err = |k: usize, l: usize| {
-            let o = DynamicOptions { solver: Solver::Collocation, terms: k, collocation: (l, 11), ..Default::default() };
+            let o =
+                DynamicOptions { solver: Solver::Collocation, terms: k, collocation: (l, 11), ..Default::default() };
             let f = DynamicBlend::new(op19(), &conds, VDomain::PERIODIC, &o).unwrap().frame(0.0).unwrap();
             assert!(check_conditions(&f, &conds, 0.0, 1000).max_rel < 1e-12);
             (0..=1000)

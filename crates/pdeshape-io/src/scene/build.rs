@@ -5,7 +5,9 @@ use super::raw::*;
 use super::{Param, PatchKind, RenderSettings, Scene, ScenePatch, SceneSurface};
 use indexmap::IndexMap;
 use pdeshape_core::Vec3;
-use pdeshape_core::blend::{BasisFn, BlendOptions, Operator, Solver, StaticBlend};
+use pdeshape_core::blend::{
+    BasisFn, BlendOptions, DynBasis, DynamicBlend, DynamicOperator, DynamicOptions, Operator, Solver, StaticBlend,
+};
 use pdeshape_core::data::{BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative};
 use pdeshape_core::expr::{BinOp, Expr, ExprError, Func, Node};
 use pdeshape_core::patch::{Condition, HermitePatch, VDomain};
@@ -32,6 +34,8 @@ struct Ctx<'a> {
     params: IndexMap<String, Param>,
     /// Solver override for patches that offer a choice.
     solver: Option<Solver>,
+    /// Override of the sine-term count of dynamic blends.
+    terms: Option<usize>,
 }
 
 fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
@@ -542,7 +546,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
             src.error(None, "--solver", format!("unknown solver `{w}` (known: auto, exact, collocation)"))
         })?),
     };
-    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver };
+    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver, terms: opts.terms };
     let mut taken: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.parameters {
         check_name(&src, n, span(p), &format!("parameters.{n}"), &mut taken)?;
@@ -656,12 +660,13 @@ fn build_patch(
         "hermite" => PatchKind::Hermite,
         "pde" => PatchKind::Pde,
         "blend" => PatchKind::Blend,
-        k @ ("dynamic" | "solid") => {
+        "dynamic" => PatchKind::Dynamic,
+        k @ "solid" => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
                 format!(
-                    "patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde, blend)"
+                    "patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde, blend, dynamic)"
                 ),
             ));
         }
@@ -669,12 +674,15 @@ fn build_patch(
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("unknown patch kind `{k}` (known: hermite, pde, blend)"),
+                format!("unknown patch kind `{k}` (known: hermite, pde, blend, dynamic, solid)"),
             ));
         }
     };
     let only = |present: bool, name: &str, for_kind: PatchKind| -> R<()> {
-        if present && kind != for_kind {
+        // start/end, solver and the collocation grid serve both kinds of blend
+        let shared = matches!(name, "start" | "end" | "solver" | "collocation" | "basis")
+            && matches!(kind, PatchKind::Blend | PatchKind::Dynamic);
+        if present && kind != for_kind && !shared {
             return Err(ctx.err(
                 span(p),
                 format!("{key}.{name}"),
@@ -695,6 +703,19 @@ fn build_patch(
     only(rp.basis.is_some(), "basis", PatchKind::Blend)?;
     only(rp.start.is_some(), "start", PatchKind::Blend)?;
     only(rp.end.is_some(), "end", PatchKind::Blend)?;
+    for (present, name) in [
+        (rp.beta.is_some(), "beta"),
+        (rp.gamma.is_some(), "gamma"),
+        (rp.lambda.is_some(), "lambda"),
+        (rp.rho.is_some(), "rho"),
+        (rp.eta.is_some(), "eta"),
+        (rp.terms.is_some(), "terms"),
+        (rp.joint.is_some(), "joint"),
+        (rp.time.is_some(), "time"),
+        (rp.frames.is_some(), "frames"),
+    ] {
+        only(present, name, PatchKind::Dynamic)?;
+    }
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;
     if rp.conditions.is_none() && rp.sections.is_none() && rp.start.is_none() && rp.end.is_none() {
@@ -734,7 +755,8 @@ fn build_patch(
             Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ek}.scale"))?,
             None => 1.0,
         };
-        for order in 0..=2 {
+        let top = if kind == PatchKind::Dynamic { 1 } else { 2 };
+        for order in 0..=top {
             let data: FieldRef = Arc::new(Trimline::new(surf.field.clone(), s0, order, scale));
             check_data(ctx, &data, domain, span(e), &format!("{ek} (order {order})"))?;
             conditions.push(Condition { u: end_u, order, data });
@@ -795,7 +817,9 @@ fn build_patch(
             Arc::new(Trimline::new(surf.field.clone(), s0, order, scale))
         };
         check_data(ctx, &data, domain, span(rc), &ck)?;
-        if kind == PatchKind::Blend && conditions.iter().any(|o| o.u == u && o.order == order) {
+        if matches!(kind, PatchKind::Blend | PatchKind::Dynamic)
+            && conditions.iter().any(|o| o.u == u && o.order == order)
+        {
             return Err(ctx.err(
                 span(rc),
                 &ck,
@@ -806,6 +830,7 @@ fn build_patch(
     }
     let mut spectral = None;
     let mut blend = None;
+    let mut dynamic = None;
     let surface: Arc<dyn pdeshape_core::patch::Surface> = match kind {
         PatchKind::Hermite => Arc::new(
             HermitePatch::new(&conditions, domain)
@@ -834,9 +859,108 @@ fn build_patch(
             blend = Some(setup);
             b
         }
+        PatchKind::Dynamic => {
+            let setup = build_dynamic(ctx, &key, p, &conditions, domain, conds_span.clone())?;
+            let f = setup
+                .blend
+                .frame(setup.times.0)
+                .map_err(|e| ctx.err(conds_span.clone().or(Some(p.span())), &key, e.to_string()))?;
+            dynamic = Some(setup);
+            Arc::new(f)
+        }
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    Ok(ScenePatch { name: pname.to_string(), kind, surface, conditions, resolution, color, spectral, sections, blend })
+    Ok(ScenePatch {
+        name: pname.to_string(),
+        kind,
+        surface,
+        conditions,
+        resolution,
+        color,
+        spectral,
+        sections,
+        blend,
+        dynamic,
+    })
+}
+
+/// The operator, options and basis of a dynamic blend (SPEC §5).
+fn build_dynamic(
+    ctx: &Ctx,
+    key: &str,
+    p: &Spanned<RawPatch>,
+    conditions: &[Condition],
+    domain: VDomain,
+    conds_span: Option<Range<usize>>,
+) -> R<super::DynamicSetup> {
+    let rp = p.get_ref();
+    let num = |x: &Option<Spanned<NumOrExpr>>, name: &str, default: f64| -> R<f64> {
+        match x {
+            Some(x) => ctx.num(x.get_ref(), span(x), &format!("{key}.{name}")),
+            None => Ok(default),
+        }
+    };
+    let op = DynamicOperator::new(
+        num(&rp.beta, "beta", 1.0)?,
+        num(&rp.gamma, "gamma", 2.0)?,
+        num(&rp.lambda, "lambda", 1.0)?,
+        num(&rp.rho, "rho", 0.0)?,
+        num(&rp.eta, "eta", 0.0)?,
+    )
+    .map_err(|e| ctx.err(span(p), key, e.to_string()))?;
+    let times = match &rp.time {
+        None => (0.0, 1.0),
+        Some(r) => ctx.range(r, &format!("{key}.time"))?,
+    };
+    let frames = match &rp.frames {
+        None => 11,
+        Some(f) => ctx.int(f, 2, 1000, &format!("{key}.frames"))? as usize,
+    };
+    let mut opts = DynamicOptions { times, ..Default::default() };
+    if let Some(sv) = &rp.solver {
+        opts.solver = Solver::parse(sv.get_ref()).ok_or_else(|| {
+            ctx.err(
+                span(sv),
+                format!("{key}.solver"),
+                format!("unknown solver `{}` (known: auto, exact, collocation)", sv.get_ref()),
+            )
+        })?;
+    }
+    if let Some(s) = ctx.solver {
+        opts.solver = s;
+    }
+    if let Some(k) = &rp.terms {
+        opts.terms = ctx.int(k, 1, 60, &format!("{key}.terms"))? as usize;
+    }
+    if let Some(k) = ctx.terms {
+        opts.terms = k;
+    }
+    if let Some(c) = &rp.collocation {
+        let [l, m] = *c.get_ref();
+        if !(2..=400).contains(&l) || !(1..=400).contains(&m) {
+            return Err(ctx.err(
+                span(c),
+                format!("{key}.collocation"),
+                format!("[{l}, {m}] is out of range (2 … 400)"),
+            ));
+        }
+        opts.collocation = (l as usize, m as usize);
+    }
+    opts.joint = rp.joint.as_ref().map(|j| *j.get_ref()).unwrap_or(false);
+    if let Some(list) = &rp.basis {
+        let mut basis = Vec::new();
+        for (j, t) in list.get_ref().iter().enumerate() {
+            let text = t.get_ref();
+            let bk = format!("{key}.basis[{j}]");
+            let e = Expr::parse(text).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
+            let e = e.bind(&["v", "t"], &ctx.param_lookup()).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
+            basis.push(DynBasis::Expr { expr: e, text: text.clone() });
+        }
+        opts.basis = Some(basis);
+    }
+    let blend = DynamicBlend::new(op, conditions, domain, &opts)
+        .map_err(|e| ctx.err(conds_span.or(Some(p.span())), key, e.to_string()))?;
+    Ok(super::DynamicSetup { blend: Arc::new(blend), times, frames })
 }
 
 /// Operators, options and the solve of a static blend (SPEC §4).

@@ -62,6 +62,8 @@ pub struct LoadOptions {
     pub params: HashMap<String, f64>,
     /// Solver for patches that offer a choice (blends).
     pub solver: Option<String>,
+    /// Sine terms `K` for dynamic blends (overrides the scene).
+    pub terms: Option<usize>,
 }
 
 /// What a patch is.
@@ -73,6 +75,8 @@ pub enum PatchKind {
     Pde,
     /// A static blend of 2nd, 4th, 6th or mixed order (SPEC §4).
     Blend,
+    /// A time-dependent C1 blend (SPEC §5).
+    Dynamic,
 }
 
 impl PatchKind {
@@ -82,6 +86,7 @@ impl PatchKind {
             PatchKind::Hermite => "hermite",
             PatchKind::Pde => "pde",
             PatchKind::Blend => "blend",
+            PatchKind::Dynamic => "dynamic",
         }
     }
 }
@@ -107,6 +112,28 @@ pub struct ScenePatch {
     pub sections: Option<SectionFamily>,
     /// The static blend and the options it was solved with, for blend patches.
     pub blend: Option<BlendSetup>,
+    /// The dynamic blend with its time range and frames, for dynamic patches (`surface` is
+    /// then the frame at the first time).
+    pub dynamic: Option<DynamicSetup>,
+}
+
+/// A dynamic blend with its animation settings.
+#[derive(Clone, Debug)]
+pub struct DynamicSetup {
+    /// The blend (frames are solved on demand).
+    pub blend: Arc<pdeshape_core::blend::DynamicBlend>,
+    /// `[t0, t1]`.
+    pub times: (f64, f64),
+    /// Number of frames (`t_i = t0 + i (t1 − t0)/(frames − 1)`).
+    pub frames: usize,
+}
+
+impl DynamicSetup {
+    /// The frame times.
+    pub fn frame_times(&self) -> Vec<f64> {
+        let n = self.frames.max(2);
+        (0..n).map(|i| self.times.0 + (self.times.1 - self.times.0) * i as f64 / (n - 1) as f64).collect()
+    }
 }
 
 /// A solved static blend with what is needed to solve it again another way.
@@ -261,7 +288,7 @@ impl Scene {
     /// Parses scene text. `overrides` replace parameter values (by name) before anything
     /// is resolved — the live editor's sliders.
     pub fn parse(text: &str, file: &str, name: &str, overrides: &HashMap<String, f64>) -> Result<Scene, SceneError> {
-        build::build(Source { file, text }, name, &LoadOptions { params: overrides.clone(), solver: None })
+        build::build(Source { file, text }, name, &LoadOptions { params: overrides.clone(), ..Default::default() })
     }
 
     /// Parses scene text with parameter overrides and a solver override for every patch

@@ -149,6 +149,20 @@ pub struct RawPatch {
     pub collocation: Option<Spanned<[i64; 2]>>,
     /// Blends: explicit boundary basis functions `g_j(v)`.
     pub basis: Option<Spanned<Vec<Spanned<String>>>>,
+    /// Dynamic blends: the shape parameters β, γ, λ, ρ, η.
+    pub beta: Option<Spanned<NumOrExpr>>,
+    pub gamma: Option<Spanned<NumOrExpr>>,
+    pub lambda: Option<Spanned<NumOrExpr>>,
+    pub rho: Option<Spanned<NumOrExpr>>,
+    pub eta: Option<Spanned<NumOrExpr>>,
+    /// Dynamic blends: sine terms `K` of the collocation solver.
+    pub terms: Option<Spanned<i64>>,
+    /// Dynamic blends: least squares jointly over all basis functions.
+    pub joint: Option<Spanned<bool>>,
+    /// Dynamic blends: the time range `[t0, t1]`.
+    pub time: Option<Spanned<[NumOrExpr; 2]>>,
+    /// Dynamic blends: the number of animation frames (≥ 2).
+    pub frames: Option<Spanned<i64>>,
     /// Blends: the primary surface at `u = 0` (conditions of orders 0, 1, 2 from its trimline).
     pub start: Option<Spanned<RawEnd>>,
     /// Blends: the primary surface at `u = 1`.
