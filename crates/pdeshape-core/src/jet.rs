@@ -90,8 +90,12 @@ impl JetShape {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Jet {
     shape: JetShape,
-    c: Vec<f64>,
+    c: Coeffs,
 }
+
+/// Coefficient storage: inline up to 16 coefficients (every shape up to `[3, 3, 0]` or
+/// `[4, 2, 0]`), so the jets of surface evaluation do not allocate.
+type Coeffs = smallvec::SmallVec<[f64; 16]>;
 
 fn factorial(n: usize) -> f64 {
     (1..=n).map(|k| k as f64).product()
@@ -100,7 +104,7 @@ fn factorial(n: usize) -> f64 {
 impl Jet {
     /// A constant function with value `v`.
     pub fn constant(shape: JetShape, v: f64) -> Self {
-        let mut c = vec![0.0; shape.len()];
+        let mut c: Coeffs = smallvec::smallvec![0.0; shape.len()];
         c[0] = v;
         Jet { shape, c }
     }
@@ -120,7 +124,7 @@ impl Jet {
     /// A jet from raw Taylor coefficients in storage order.
     pub fn from_coeffs(shape: JetShape, c: Vec<f64>) -> Self {
         assert_eq!(c.len(), shape.len());
-        Jet { shape, c }
+        Jet { shape, c: Coeffs::from_vec(c) }
     }
 
     /// The shape of this jet.
@@ -203,7 +207,7 @@ impl Jet {
             return self.scale(o.c[0]);
         }
         let [oa, ob, oc] = self.shape.orders;
-        let mut out = vec![0.0; self.c.len()];
+        let mut out: Coeffs = smallvec::smallvec![0.0; self.c.len()];
         for i1 in 0..=oa {
             for j1 in 0..=ob {
                 for k1 in 0..=oc {

@@ -9,3 +9,4 @@ pub mod export;
 pub mod model;
 pub mod render;
 pub mod scene;
+pub mod tables;

@@ -102,8 +102,18 @@ enum Command {
         #[arg(default_value = "gallery")]
         dir: PathBuf,
     },
-    /// Reproduce the papers' timing tables.
-    Bench,
+    /// Reproduce the papers' timing and accuracy tables beside their published figures.
+    Bench {
+        /// Print JSON instead of Markdown.
+        #[arg(long)]
+        json: bool,
+        /// Timed runs per measurement (medians are reported).
+        #[arg(long, default_value_t = 21)]
+        runs: usize,
+        /// Also write the tables to OUT.md and OUT.json.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Serve the interactive editor on localhost.
     Serve {
         /// Scene to open.
@@ -402,9 +412,7 @@ fn execute(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, cli.quiet),
-        Command::Bench => bail!(
-            "`pdeshape bench` is not available in this version: the papers' solvers it times are not implemented yet"
-        ),
+        Command::Bench { json, runs, out } => crate::bench::run(runs, json, out.as_deref()),
         Command::Serve { .. } => {
             bail!("`pdeshape serve` is not available in this version: the web editor is not implemented yet")
         }

@@ -1,6 +1,7 @@
 //! `pdeshape`: the command-line tool. A thin layer over `pdeshape-core` (mathematics) and
 //! `pdeshape-io` (scene files, exporters, pictures).
 
+mod bench;
 mod cli;
 mod gallery;
 

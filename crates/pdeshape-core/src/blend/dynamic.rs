@@ -106,9 +106,7 @@ impl DynBasis {
     }
 
     fn derivs(&self, v: f64, t: f64) -> FDerivs {
-        let p = self.partials(v, t, 4, 2);
-        // index i·3 + j
-        FDerivs { f: p[0], fvv: p[6], fvvvv: p[12], ft: p[1], ftt: p[2] }
+        fderivs(&self.partials(v, t, 4, 2))
     }
 
     /// A short name.
@@ -123,35 +121,83 @@ impl DynBasis {
     /// eigenfunction: tested at 9 × 5 points of the domain and time range from exact
     /// derivatives (relative tolerance 1e-11).
     pub fn eigenvalues(&self, domain: VDomain, times: (f64, f64)) -> Option<(f64, f64)> {
-        let pts: Vec<FDerivs> = (0..9)
-            .flat_map(|i| {
-                (0..5).map(move |k| {
-                    (domain.at((i as f64 + 0.31) / 9.2), times.0 + (times.1 - times.0) * (k as f64 + 0.17) / 4.5)
-                })
-            })
-            .map(|(v, t)| self.derivs(v, t))
-            .collect();
-        let den: f64 = pts.iter().map(|d| d.f * d.f).sum();
-        if den == 0.0 || !den.is_finite() {
-            return None;
-        }
-        let mu = pts.iter().map(|d| d.f * d.fvv).sum::<f64>() / den;
-        let kappa = pts.iter().map(|d| d.f * d.ft).sum::<f64>() / den;
-        let scale = pts.iter().fold(0.0f64, |m, d| {
-            m.max(d.fvv.abs())
-                .max(d.ft.abs())
-                .max(d.ftt.abs())
-                .max(d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa))
-        });
-        let tol = 1e-11 * scale;
-        pts.iter()
-            .all(|d| {
-                (d.fvv - mu * d.f).abs() <= tol
-                    && (d.ft - kappa * d.f).abs() <= tol
-                    && (d.ftt - kappa * kappa * d.f).abs() <= tol
-            })
-            .then_some((mu, kappa))
+        eigen_from(eigen_points(domain, times).map(|(v, t)| self.derivs(v, t)))
     }
+}
+
+/// `∂v^i ∂t^j F_k` (index `i (dt + 1) + j`) for every basis function at one point. Whole
+/// data functions that are components of the same field share one evaluation of it.
+fn partials_all(basis: &[DynBasis], v: f64, t: f64, dv: usize, dt: usize) -> Vec<Vec<f64>> {
+    let shape = JetShape::new(&[dv, dt]);
+    let mut fields: Vec<(*const (), crate::data::VecJet)> = Vec::new();
+    let pick = |jet: &Jet| {
+        let mut out = Vec::with_capacity((dv + 1) * (dt + 1));
+        for i in 0..=dv {
+            for j in 0..=dt {
+                out.push(jet.derivative([i, j, 0]));
+            }
+        }
+        out
+    };
+    basis
+        .iter()
+        .map(|b| match b {
+            DynBasis::Expr { .. } => b.partials(v, t, dv, dt),
+            DynBasis::Data { field, comp, .. } => {
+                let key = Arc::as_ptr(field) as *const ();
+                let k = match fields.iter().position(|(p, _)| *p == key) {
+                    Some(k) => k,
+                    None => {
+                        fields.push((key, field.jet(&[v, t], shape)));
+                        fields.len() - 1
+                    }
+                };
+                pick(&fields[k].1.0[*comp])
+            }
+        })
+        .collect()
+}
+
+fn fderivs(p: &[f64]) -> FDerivs {
+    // index i·3 + j for dv = 4, dt = 2
+    FDerivs { f: p[0], fvv: p[6], fvvvv: p[12], ft: p[1], ftt: p[2] }
+}
+
+/// `(μ, κ)` of every basis function that is an eigenfunction (see
+/// [`DynBasis::eigenvalues`]), sharing field evaluations.
+fn eigen_all(basis: &[DynBasis], domain: VDomain, times: (f64, f64)) -> Vec<Option<(f64, f64)>> {
+    let pts: Vec<Vec<FDerivs>> = eigen_points(domain, times)
+        .map(|(v, t)| partials_all(basis, v, t, 4, 2).iter().map(|p| fderivs(p)).collect())
+        .collect();
+    (0..basis.len()).map(|j| eigen_from(pts.iter().map(|row| row[j]))).collect()
+}
+
+fn eigen_points(domain: VDomain, times: (f64, f64)) -> impl Iterator<Item = (f64, f64)> {
+    (0..9).flat_map(move |i| {
+        (0..5)
+            .map(move |k| (domain.at((i as f64 + 0.31) / 9.2), times.0 + (times.1 - times.0) * (k as f64 + 0.17) / 4.5))
+    })
+}
+
+fn eigen_from(pts: impl Iterator<Item = FDerivs>) -> Option<(f64, f64)> {
+    let pts: Vec<FDerivs> = pts.collect();
+    let den: f64 = pts.iter().map(|d| d.f * d.f).sum();
+    if den == 0.0 || !den.is_finite() {
+        return None;
+    }
+    let mu = pts.iter().map(|d| d.f * d.fvv).sum::<f64>() / den;
+    let kappa = pts.iter().map(|d| d.f * d.ft).sum::<f64>() / den;
+    let scale = pts.iter().fold(0.0f64, |m, d| {
+        m.max(d.fvv.abs()).max(d.ft.abs()).max(d.ftt.abs()).max(d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa))
+    });
+    let tol = 1e-11 * scale;
+    pts.iter()
+        .all(|d| {
+            (d.fvv - mu * d.f).abs() <= tol
+                && (d.ft - kappa * d.f).abs() <= tol
+                && (d.ftt - kappa * kappa * d.f).abs() <= tol
+        })
+        .then_some((mu, kappa))
 }
 
 /// The corrected sine terms: `ζ_k(u) = sin kπu − kπ [ξ₂(u) + (−1)ᵏ ξ₄(u)]` with the cubic
@@ -358,7 +404,7 @@ impl DynamicBlend {
             None => extract(&used),
             Some(b) => (b.clone(), project(&used, b, domain, opts.times)?),
         };
-        let eigen: Vec<Option<(f64, f64)>> = basis.iter().map(|f| f.eigenvalues(domain, opts.times)).collect();
+        let eigen = eigen_all(&basis, domain, opts.times);
         let exact_ok = eigen.iter().all(|e| e.is_some()) && op.beta != 0.0;
         let use_exact = match opts.solver {
             Solver::Auto => exact_ok,
@@ -444,7 +490,8 @@ impl DynamicBlend {
                 }
             })
             .collect();
-        let fd: Vec<Vec<FDerivs>> = vs.iter().map(|&v| self.basis.iter().map(|f| f.derivs(v, t)).collect()).collect();
+        let fd: Vec<Vec<FDerivs>> =
+            vs.iter().map(|&v| partials_all(&self.basis, v, t, 4, 2).iter().map(|p| fderivs(p)).collect()).collect();
         let z: Vec<Vec<[f64; 5]>> = us.iter().map(|&u| (1..=k).map(|kk| zeta(kk, u)).collect()).collect();
         let h: Vec<[[f64; 5]; 4]> = us.iter().map(|&u| hermite(u)).collect();
         // Hermite part of G_j at u_l (derivatives 0..4), per component
@@ -621,9 +668,10 @@ impl DynamicFrame {
     /// depend on `t`).
     pub fn residual(&self, u: f64, v: f64) -> Vec3 {
         let mut r = Vec3::ZERO;
-        for (f, prof) in self.basis.iter().zip(&self.profiles) {
+        let all = partials_all(&self.basis, v, self.t, 4, 2);
+        for (p, prof) in all.iter().zip(&self.profiles) {
             let g = prof.eval(u, 4);
-            let d = f.derivs(v, self.t);
+            let d = fderivs(p);
             for comp in 0..3 {
                 let gc: [f64; 5] = std::array::from_fn(|i| g[i][comp]);
                 r[comp] += self.op.apply(&gc, &d);
@@ -640,9 +688,9 @@ impl Surface for DynamicFrame {
 
     fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
         let mut out = vec![Vec3::ZERO; (du + 1) * (dv + 1)];
-        for (f, prof) in self.basis.iter().zip(&self.profiles) {
+        let all = partials_all(&self.basis, v, self.t, dv, 0);
+        for (fv, prof) in all.iter().zip(&self.profiles) {
             let g = prof.eval(u, du);
-            let fv = f.partials(v, self.t, dv, 0);
             for i in 0..=du {
                 for j in 0..=dv {
                     out[i * (dv + 1) + j] += g[i] * fv[j];
@@ -654,8 +702,7 @@ impl Surface for DynamicFrame {
 
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
         use rayon::prelude::*;
-        let cols: Vec<Vec<Vec<f64>>> =
-            vs.par_iter().map(|&v| self.basis.iter().map(|f| f.partials(v, self.t, 1, 0)).collect()).collect();
+        let cols: Vec<Vec<Vec<f64>>> = vs.par_iter().map(|&v| partials_all(&self.basis, v, self.t, 1, 0)).collect();
         us.par_iter()
             .flat_map_iter(|&u| {
                 let row: Vec<Vec<Vec3>> = self.profiles.iter().map(|p| p.eval(u, 1)).collect();

@@ -1,0 +1,109 @@
+//! `pdeshape bench`: the papers' timing and accuracy tables beside ours.
+
+use crate::EXAMPLES;
+use anyhow::{Result, anyhow};
+use pdeshape_io::scene::Scene;
+use pdeshape_io::tables::{self, AccuracyRow, Table1Row};
+use serde_json::json;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+fn example(name: &str) -> Result<Scene> {
+    let text =
+        EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))?;
+    Ok(Scene::parse(text, &format!("examples/{name}.toml"), name, &HashMap::new())?)
+}
+
+/// Runs every table; prints Markdown (or JSON) and optionally writes both next to `out`.
+pub fn run(runs: usize, json_out: bool, out: Option<&Path>) -> Result<()> {
+    let scene = example("dynamic-elliptic-cylinders")?;
+    let (t1, acc) = tables::on_one_thread(|| -> Result<(Vec<Table1Row>, Vec<AccuracyRow>), String> {
+        Ok((tables::dynamic_table1(&scene, runs)?, tables::dynamic_accuracy(&scene)?))
+    })
+    .map_err(|e| anyhow!(e))?
+    .map_err(|e| anyhow!(e))?;
+    let doc = json!({
+        "machine": machine(),
+        "threads": 1,
+        "paper_002_table_1": t1,
+        "paper_002_accuracy": acc,
+    });
+    let md = markdown(&t1, &acc, runs);
+    if json_out {
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        print!("{md}");
+    }
+    if let Some(path) = out {
+        let md_path = path.with_extension("md");
+        let js_path = path.with_extension("json");
+        pdeshape_io::export::write_atomic(&md_path, |w| w.write_all(md.as_bytes()))?;
+        pdeshape_io::export::write_atomic(&js_path, |w| w.write_all(serde_json::to_string_pretty(&doc)?.as_bytes()))?;
+    }
+    Ok(())
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    format!("{cpu}, {cores} cores available, timings on 1 thread")
+}
+
+fn markdown(t1: &[Table1Row], acc: &[AccuracyRow], runs: usize) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "## Paper 002, Table 1: dynamic blend of eq. 19, 100 × 100 points at t = 0\n");
+    let _ = writeln!(
+        s,
+        "Machine: {}. Ours: solve + evaluation with normals, median (min–max) of {runs} runs.\n",
+        machine()
+    );
+    let _ = writeln!(s, "| method | paper (1.66 GHz laptop) | ours | max deviation from the closed form |");
+    let _ = writeln!(s, "|---|---|---|---|");
+    for r in t1 {
+        let _ = writeln!(
+            s,
+            "| {} | {:.3} s | {:.3} ms ({:.3}–{:.3}) | {} |",
+            r.method,
+            r.paper_seconds,
+            r.ours.median_ms,
+            r.ours.min_ms,
+            r.ours.max_ms,
+            if r.method == "closed form" { "—".to_string() } else { format!("{:.2e}", r.max_deviation) }
+        );
+    }
+    let _ = writeln!(s, "\n## Paper 002, accuracy of the collocation solution (eq. 19)\n");
+    let _ = writeln!(s, "Max |S_collocation − S_closed form| over 100 × 100 points.\n");
+    let _ = writeln!(s, "| t | grid | fit | K = 5 | K = 7 | K = 10 |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for t in [0.0, 0.1, 0.2, 0.3] {
+        for grid in [11, 41] {
+            for fit in ["per-j", "joint"] {
+                let cell = |k: usize| {
+                    acc.iter()
+                        .find(|r| r.t == t && r.grid == grid && r.fit == fit && r.k == k)
+                        .map(|r| format!("{:.2e}", r.max_deviation))
+                        .unwrap_or_default()
+                };
+                let _ = writeln!(s, "| {t:.1} | {grid} × {grid} | {fit} | {} | {} | {} |", cell(5), cell(7), cell(10));
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nOn the paper's 11 points in u, ten sine terms nearly interpolate the residual and \
+         oscillate between the points (K = 10 is worse than K = 5); on 41 points the error \
+         decreases with K, but slowly: the correction G − (Hermite cubic) vanishes with its \
+         slope at both ends yet not its curvature, so its expansion in the corrected sines \
+         converges only algebraically. The closed form is exact and is what `solver = \"auto\"` \
+         uses whenever the basis functions are eigenfunctions."
+    );
+    s
+}
