@@ -1,8 +1,10 @@
 //! SPEC §10 surface targets: 4th-order PDE surface (M = 6 plus remainder) at 100 × 100
-//! points with normals; the Klein bottle (order 40) at 200 × 200.
+//! points with normals; the Klein bottle (order 40) at 200 × 200; the dynamic blend of
+//! paper 002 eq. 19 (closed form and K = 5) at 100 × 100.
 //! Run: cargo bench -p pdeshape-io --bench surfaces
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
@@ -40,6 +42,23 @@ fn surfaces(c: &mut Criterion) {
     )
     .unwrap();
     g.bench_function("bloor-wilson solve", |b| b.iter(|| Scene::parse(&text, "b", "b", &Default::default()).unwrap()));
+    g.finish();
+
+    // SPEC §10: paper 002 eq. 19 at one t, 100 × 100 points with normals: the closed form
+    // (target 2 ms) and K = 5 on 11 × 11 collocation points (target 1 ms), solve included.
+    let dynamic = load("dynamic-elliptic-cylinders.toml");
+    let p = &dynamic.patches[0];
+    let d = p.dynamic.as_ref().expect("a dynamic patch");
+    let mut g = c.benchmark_group("dynamic blend eq. 19, solve + 100x100 with normals");
+    for (label, solver) in [("closed form", Solver::Exact), ("K = 5, 11 x 11", Solver::Collocation)] {
+        let o = DynamicOptions { solver, terms: 5, collocation: (11, 11), times: d.times, ..Default::default() };
+        g.bench_function(label, |b| {
+            b.iter(|| {
+                let blend = DynamicBlend::new(d.blend.operator(), &p.conditions, p.surface.v_domain(), &o).unwrap();
+                grid_mesh(&blend.frame(0.1).unwrap(), &GridOptions::new(100, 100)).expect("finite")
+            })
+        });
+    }
     g.finish();
 }
 

@@ -256,6 +256,40 @@ pub fn dynamic_strip(scene: &Scene) -> Option<Result<Image, String>> {
     Some(run())
 }
 
+/// A parameter study as an image strip: the scene re-solved for each value of the varying
+/// parameter (other parameters as in `study.set`), drawn at its first time, captioned.
+pub fn study_strip(scene: &Scene, study: &crate::scene::Study) -> Result<Image, String> {
+    let mut panels = Vec::new();
+    for &x in &study.values {
+        let mut over: std::collections::HashMap<String, f64> = study.set.iter().cloned().collect();
+        over.insert(study.vary.clone(), x);
+        let sc = Scene::parse(&scene.source, &scene.file, &scene.name, &over).map_err(|e| e.to_string())?;
+        let t0 = sc.patches.iter().find_map(|p| p.dynamic.as_ref().map(|d| d.times.0)).unwrap_or(0.0);
+        let patches = patch_meshes(&sc)?;
+        let context = context_meshes_at(&sc, t0)?;
+        let colors: Vec<_> = sc.patches.iter().map(|p| p.color).collect();
+        let mut r = sc.render.clone();
+        r.size = (360, 420);
+        let img = render_meshes(&patches, &context, &colors, &r);
+        let mut panel = Image::new(img.width, img.height + 34, [255, 255, 255]);
+        panel.paste(&img, 0, 0);
+        crate::render::draw_text(
+            &mut panel,
+            10.0,
+            img.height as f32 + 4.0,
+            22.0,
+            &format!("{} = {x}", study.vary),
+            [30, 30, 40],
+        );
+        panels.push(panel);
+    }
+    let strip = Image::strip(&panels, 4, [255, 255, 255]);
+    let mut out = Image::new(strip.width, strip.height + 40, [255, 255, 255]);
+    out.paste(&strip, 0, 40);
+    crate::render::draw_text(&mut out, 10.0, 6.0, 24.0, &study.title, [20, 20, 30]);
+    Ok(out)
+}
+
 fn palette(k: usize) -> [f64; 3] {
     PALETTE[k % PALETTE.len()].map(f64::from)
 }

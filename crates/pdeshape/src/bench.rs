@@ -102,8 +102,12 @@ fn markdown(t1: &[Table1Row], acc: &[AccuracyRow], runs: usize) -> String {
          oscillate between the points (K = 10 is worse than K = 5); on 41 points the error \
          decreases with K, but slowly: the correction G − (Hermite cubic) vanishes with its \
          slope at both ends yet not its curvature, so its expansion in the corrected sines \
-         converges only algebraically. The closed form is exact and is what `solver = \"auto\"` \
-         uses whenever the basis functions are eigenfunctions."
+         converges only algebraically. The joint fit is worse on these data: at one instant \
+         e^t sin v and e^−t sin v (likewise the cosines) coincide up to a factor, so the \
+         instantaneous residual cannot tell their profiles apart; the joint least squares lowers \
+         the residual by trading between them and lands farther from the closed form, while the \
+         per-j fit ties each G_j to its own ODE. The closed form is exact and is what \
+         `solver = \"auto\"` uses whenever the basis functions are eigenfunctions."
     );
     s
 }

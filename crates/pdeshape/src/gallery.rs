@@ -65,6 +65,17 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
             return e;
         }
     }
+    for (i, st) in scene.studies.iter().enumerate() {
+        match model::study_strip(&scene, st) {
+            Ok(img) => {
+                let rel = format!("{name}/{name}-study-{i}.png");
+                if pdeshape_io::export::write_atomic(&dir.join(&rel), |w| img.write_png(w)).is_ok() {
+                    e.plots.push(rel);
+                }
+            }
+            Err(err) => e.error = Some(err),
+        }
+    }
     if let Some(plot) = model::blend_convergence_plot(&scene) {
         match plot {
             Ok(img) => {

@@ -631,6 +631,26 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
         }
     };
 
+    let mut studies = Vec::new();
+    for (i, st) in raw.studies.iter().enumerate() {
+        let r = st.get_ref();
+        let key = format!("studies[{i}]");
+        for n in r.set.keys().chain(std::iter::once(&r.vary)) {
+            if !ctx.params.contains_key(n) {
+                return Err(ctx.err(span(st), &key, format!("unknown parameter `{n}`")));
+            }
+        }
+        if r.values.is_empty() || r.values.len() > 12 || r.values.iter().chain(r.set.values()).any(|x| !x.is_finite()) {
+            return Err(ctx.err(span(st), &key, "a study needs 1 … 12 finite values"));
+        }
+        studies.push(super::Study {
+            title: r.title.clone(),
+            set: r.set.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+            vary: r.vary.clone(),
+            values: r.values.clone(),
+        });
+    }
+
     Ok(Scene {
         file: src.file.to_string(),
         name: name.to_string(),
@@ -644,6 +664,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
         patches,
         render,
         formats,
+        studies,
     })
 }
 

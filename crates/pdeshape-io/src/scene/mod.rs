@@ -240,6 +240,19 @@ impl Default for RenderSettings {
     }
 }
 
+/// A parameter study: the scene re-solved for each value of one parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Study {
+    /// Caption of the strip.
+    pub title: String,
+    /// Parameters fixed for the whole study.
+    pub set: Vec<(String, f64)>,
+    /// The varying parameter.
+    pub vary: String,
+    /// Its values, one panel each.
+    pub values: Vec<f64>,
+}
+
 /// A loaded and resolved scene.
 #[derive(Debug)]
 pub struct Scene {
@@ -267,6 +280,8 @@ pub struct Scene {
     pub render: RenderSettings,
     /// Output formats (file extensions) for directory builds and the gallery.
     pub formats: Vec<String>,
+    /// Parameter studies (`[[studies]]`).
+    pub studies: Vec<Study>,
 }
 
 impl Scene {

@@ -239,4 +239,20 @@ pub struct RawScene {
     pub render: RawRender,
     #[serde(default)]
     pub output: RawOutput,
+    /// Parameter studies drawn as image strips in the gallery.
+    #[serde(default)]
+    pub studies: Vec<Spanned<RawStudy>>,
+}
+
+/// `[[studies]]`: one picture per value of a parameter, with other parameters fixed.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStudy {
+    pub title: String,
+    /// Parameters fixed for the whole study.
+    #[serde(default)]
+    pub set: IndexMap<String, f64>,
+    /// The parameter that varies.
+    pub vary: String,
+    pub values: Vec<f64>,
 }
