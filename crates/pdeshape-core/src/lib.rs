@@ -23,6 +23,7 @@ pub mod linalg;
 pub mod mesh;
 pub mod ode;
 pub mod patch;
+pub mod solid;
 pub mod spectral;
 mod vec3;
 
