@@ -1,11 +1,13 @@
 //! SPEC §10 surface targets: 4th-order PDE surface (M = 6 plus remainder) at 100 × 100
 //! points with normals; the Klein bottle (order 40) at 200 × 200; the dynamic blend of
-//! paper 002 eq. 19 (closed form and K = 5) at 100 × 100.
+//! paper 002 eq. 19 (closed form and K = 5) at 100 × 100; the solid blend of paper 000
+//! example 2 (solve at L = M = N = 6, evaluation at 64³).
 //! Run: cargo bench -p pdeshape-io --bench surfaces
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
+use pdeshape_core::solid::{SolidBlend, SolidOptions, Trial};
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
 
@@ -59,6 +61,24 @@ fn surfaces(c: &mut Criterion) {
             })
         });
     }
+    g.finish();
+
+    // SPEC §10: solid blend L = M = N = 6 solve (target 20 ms), 64³ evaluation (50 ms).
+    let solid = load("solid-cylinders.toml");
+    let sd = solid.patches[0].solid.as_ref().expect("a solid patch");
+    let mut g = c.benchmark_group("solid blend (elliptic to circular cylinder)");
+    g.bench_function("solve L = M = N = 6", |b| {
+        b.iter(|| {
+            SolidBlend::new(
+                sd.blend.operator(),
+                sd.faces.clone(),
+                SolidOptions { trial: Trial::Complete, terms: (6, 6, 6) },
+            )
+            .unwrap()
+        })
+    });
+    let lin: Vec<f64> = (0..64).map(|i| i as f64 / 63.0).collect();
+    g.bench_function("evaluate 64^3", |b| b.iter(|| sd.blend.grid(&lin, &lin, &lin)));
     g.finish();
 }
 

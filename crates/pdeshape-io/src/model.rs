@@ -15,6 +15,12 @@ pub const CHECK_SAMPLES: usize = 1000;
 /// Meshes one patch at its resolution, with its position conditions as highlighted
 /// curves. Fails when the patch is not finite somewhere.
 pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
+    if let Some(sd) = &p.solid {
+        let mut m = pdeshape_core::solid::boundary_mesh(&sd.blend, sd.cells);
+        m.name = p.name.clone();
+        m.check_finite()?;
+        return Ok(m);
+    }
     let (nu, nv) = p.resolution;
     let mut m =
         grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
@@ -110,6 +116,38 @@ fn add_continuity_fields(m: &mut Mesh, p: &ScenePatch, s: &dyn pdeshape_core::pa
     }
 }
 
+/// The hexahedral volume mesh of a solid patch (`None` for other patches).
+pub fn solid_volume(p: &ScenePatch) -> Option<pdeshape_core::mesh::HexMesh> {
+    let sd = p.solid.as_ref()?;
+    let mut h = pdeshape_core::solid::hex_mesh(&sd.blend, sd.cells);
+    h.name = p.name.clone();
+    Some(h)
+}
+
+/// The blended (primary) solids of a solid patch, drawn as extrusions of its end faces
+/// along the cross tangents: `S₁ − s S₂` and `S₃ + s S₄`, `s ∈ [0, primary]`.
+pub fn solid_context(p: &ScenePatch) -> Vec<Mesh> {
+    let Some(sd) = &p.solid else { return vec![] };
+    if sd.primary <= 0.0 {
+        return vec![];
+    }
+    let f = &sd.faces;
+    let e = sd.primary;
+    type Map<'a> = Box<dyn Fn(f64, f64, f64) -> pdeshape_core::Vec3 + Sync + 'a>;
+    let ends: [Map; 2] = [
+        Box::new(move |u, v, s| f[0].eval(&[u, v]) - f[1].eval(&[u, v]) * (e * s)),
+        Box::new(move |u, v, s| f[2].eval(&[u, v]) + f[3].eval(&[u, v]) * (e * s)),
+    ];
+    ends.iter()
+        .enumerate()
+        .map(|(k, x)| {
+            let mut m = pdeshape_core::solid::boundary_mesh_of(x.as_ref(), (sd.cells.0, sd.cells.1, 5));
+            m.name = format!("{}-primary-{}", p.name, k + 1);
+            m
+        })
+        .collect()
+}
+
 /// Meshes of all patches, in scene order.
 pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
     scene.patches.iter().map(patch_mesh).collect()
@@ -159,7 +197,10 @@ pub fn render_scene(scene: &Scene) -> Result<Image, String> {
         return strip;
     }
     let patches = patch_meshes(scene)?;
-    let context = context_meshes(scene)?;
+    let mut context = context_meshes(scene)?;
+    for p in &scene.patches {
+        context.extend(solid_context(p));
+    }
     let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
     Ok(render_meshes(&patches, &context, &colors, &scene.render))
 }
@@ -298,8 +339,69 @@ fn palette(k: usize) -> [f64; 3] {
 /// (SPEC §3 "Many sections").
 pub const LEBESGUE_WARNING: f64 = 1e3;
 
+/// Diagnostics of a solid patch: the four boundary conditions on a 50 × 50 grid of
+/// `(u, v)`, the solve, mass properties, the RMS PDE residual at interior points.
+fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
+    let s = sd.blend.as_ref();
+    let (mut worst, mut size) = (0.0f64, 0.0f64);
+    for i in 0..50 {
+        for j in 0..50 {
+            let (u, v) = (i as f64 / 49.0, j as f64 / 49.0);
+            for (w, k, f) in [(0.0, 0, 0), (0.0, 1, 1), (1.0, 0, 2), (1.0, 1, 3)] {
+                let d = s.derivatives(u, v, w, 0, 0, 1)[k];
+                let g = sd.faces[f].eval(&[u, v]);
+                worst = worst.max((d - g).norm());
+                size = size.max(g.norm());
+            }
+        }
+    }
+    let mp = s.mass_properties(16);
+    // interior points (boundary surfaces may have singular derivatives on the edges)
+    let mut r2 = 0.0;
+    let n = 512;
+    for i in 0..n {
+        let at = |a: f64, b: f64| 0.02 + 0.96 * (i as f64 * a + b).fract();
+        let (u, v, w) = (at(0.618034, 0.1), at(0.414214, 0.2), at(0.732051, 0.3));
+        r2 += s.residual(u, v, w).norm().powi(2);
+    }
+    let rep = s.report();
+    let mut warnings = Vec::new();
+    if mp.folds() {
+        warnings.push(json!(format!(
+            "the solid folds: det J ranges over [{:.3e}, {:.3e}]; raise lmn or change the boundary surfaces",
+            mp.min_jacobian, mp.max_jacobian
+        )));
+    }
+    json!({
+        "name": p.name,
+        "kind": "solid",
+        "solver": rep.method,
+        "conditions": [{"w": 0, "order": 0}, {"w": 0, "order": 1}, {"w": 1, "order": 0}, {"w": 1, "order": 1}],
+        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": worst / size.max(f64::MIN_POSITIVE), "patch_size": size},
+        "solid": {
+            "terms": [rep.terms.0, rep.terms.1, rep.terms.2],
+            "condition_number": rep.condition_number,
+            "max_coefficient": rep.max_coefficient,
+            "rms_residual": (r2 / n as f64).sqrt(),
+            "cells": [sd.cells.0, sd.cells.1, sd.cells.2],
+        },
+        "mass_properties": {
+            "volume": mp.volume,
+            "centroid": [mp.centroid.x, mp.centroid.y, mp.centroid.z],
+            "inertia": mp.inertia,
+            "min_jacobian": mp.min_jacobian,
+            "max_jacobian": mp.max_jacobian,
+            "folds": mp.folds(),
+        },
+        "warnings": warnings,
+    })
+}
+
 /// Diagnostics of one patch, as `check --json` prints them.
 pub fn patch_diagnostics(p: &ScenePatch) -> Value {
+    if let Some(sd) = &p.solid {
+        return solid_diagnostics(p, sd);
+    }
     let mut rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
     if let Some(b) = &p.blend {
         rep = blend_condition_report(b.blend.as_ref(), &p.conditions);
@@ -670,6 +772,66 @@ pub fn blend_convergence_plot(scene: &Scene) -> Option<Result<Image, String>> {
         true,
         (640, 420),
     ))
+}
+
+/// The convergence study of a solid patch: for `L = M = N = 2 … 12`, the max change of the
+/// solid from the previous `L` at 300 interior points and the RMS PDE residual there.
+pub fn solid_convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
+    use pdeshape_core::solid::{SolidBlend, SolidOptions};
+    let sd = p.solid.as_ref()?;
+    let base = sd.blend.report();
+    let trial = match base.method {
+        "galerkin" => pdeshape_core::solid::Trial::Galerkin,
+        "collocation" => pdeshape_core::solid::Trial::Collocation,
+        _ => pdeshape_core::solid::Trial::Complete,
+    };
+    let pts: Vec<(f64, f64, f64)> = (0..300)
+        .map(|i| {
+            let at = |a: f64, b: f64| 0.02 + 0.96 * (i as f64 * a + b).fract();
+            (at(0.618034, 0.1), at(0.414214, 0.2), at(0.732051, 0.3))
+        })
+        .collect();
+    let (mut change, mut rms) = (Vec::new(), Vec::new());
+    let mut prev: Option<Vec<pdeshape_core::Vec3>> = None;
+    let top = if trial == pdeshape_core::solid::Trial::Collocation { 8 } else { 12 };
+    for n in 2..=top {
+        let opts = SolidOptions { trial, terms: (n, n, n) };
+        let Ok(s) = SolidBlend::new(sd.blend.operator(), sd.faces.clone(), opts) else { continue };
+        let xs: Vec<_> = pts.iter().map(|&(u, v, w)| s.point(u, v, w)).collect();
+        let r2: f64 = pts.iter().map(|&(u, v, w)| s.residual(u, v, w).norm().powi(2)).sum::<f64>() / pts.len() as f64;
+        rms.push((n as f64, r2.sqrt().max(1e-16)));
+        if let Some(pv) = &prev {
+            let d = pv.iter().zip(&xs).map(|(a, b)| (*a - *b).norm()).fold(0.0, f64::max);
+            change.push((n as f64, d.max(1e-16)));
+        }
+        prev = Some(xs);
+    }
+    Some(crate::render::line_plot(
+        &format!("{}: convergence in the number of terms L = M = N", p.name),
+        "L = M = N",
+        "size",
+        &[
+            crate::render::Series { label: "max change from L − 1".into(), points: change },
+            crate::render::Series { label: "RMS PDE residual".into(), points: rms },
+        ],
+        true,
+        (640, 420),
+    ))
+}
+
+/// Iso-parametric cross sections of a solid patch (w = ¼, ½, ¾ and v = ¼, ¾), drawn with
+/// the blended solids: the papers' Figs. 1b–3b.
+pub fn solid_sections_picture(scene: &Scene, p: &ScenePatch) -> Option<Result<Image, String>> {
+    let sd = p.solid.as_ref()?;
+    let mut meshes = Vec::new();
+    for (axis, value) in [(2, 0.25), (2, 0.5), (2, 0.75), (1, 0.25), (1, 0.75)] {
+        let mut m = pdeshape_core::solid::cross_section(&sd.blend, axis, value, 33);
+        m.name = format!("{}-section-{axis}-{value}", p.name);
+        meshes.push(m);
+    }
+    let colors = vec![p.color; meshes.len()];
+    let context = solid_context(p);
+    Some(Ok(render_meshes(&meshes, &context, &colors, &scene.render)))
 }
 
 /// Diagnostics of a scene.

@@ -228,6 +228,15 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
             written.push(path);
         }
     }
+    // solid blends: the hexahedral volume mesh (with residual and Jacobian cell fields)
+    for p in &scene.patches {
+        if let Some(h) = model::solid_volume(p) {
+            let path = dir.join(format!("{}-{}-volume.vtu", scene.name, p.name));
+            write_atomic(&path, |w| pdeshape_io::export::write_vtu_hex(w, &h))
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            written.push(path);
+        }
+    }
     // dynamic blends: a numbered frame sequence beside the animated glTF
     for p in &scene.patches {
         if let Some(frames) = model::frame_meshes(p) {
@@ -325,6 +334,18 @@ fn execute(cli: Cli) -> Result<()> {
                     if let Some(line) = continuity_line(p) {
                         println!("      {line}");
                     }
+                    if let (Some(so), Some(mp)) = (p["solid"].as_object(), p["mass_properties"].as_object()) {
+                        println!(
+                            "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",
+                            so["terms"],
+                            so["condition_number"].as_f64().unwrap_or(f64::NAN),
+                            so["rms_residual"].as_f64().unwrap_or(f64::NAN),
+                            mp["volume"].as_f64().unwrap_or(f64::NAN),
+                            mp["centroid"],
+                            mp["min_jacobian"].as_f64().unwrap_or(f64::NAN),
+                            mp["max_jacobian"].as_f64().unwrap_or(f64::NAN),
+                        );
+                    }
                     if let Some(b) = p["blend"].as_object() {
                         for c in b["components"].as_array().into_iter().flatten() {
                             println!(
@@ -381,8 +402,9 @@ fn execute(cli: Cli) -> Result<()> {
                     eprintln!("note: patch `{}` is not a dynamic blend: --time does not change it", p.name);
                 }
             }
-            match (&p.dynamic, time) {
-                (Some(d), Some(t)) => {
+            match (&p.dynamic, time, &p.solid) {
+                (_, _, Some(sd)) => sample_solid(&sd.blend),
+                (Some(d), Some(t), _) => {
                     let f = d.blend.frame(t).map_err(|e| anyhow!("patch `{}` at t = {t}: {e}", p.name))?;
                     sample(&f)
                 }
@@ -417,6 +439,43 @@ fn execute(cli: Cli) -> Result<()> {
             bail!("`pdeshape serve` is not available in this version: the web editor is not implemented yet")
         }
     }
+}
+
+/// `u,v,w` from stdin to `u,v,w,x,y,z` for a solid blend.
+fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    writeln!(out, "u,v,w,x,y,z")?;
+    for (ln, line) in stdin.lock().lines().enumerate() {
+        let line = line.context("cannot read stdin")?;
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
+        if ln == 0 && cols.first().is_some_and(|c| c.parse::<f64>().is_err()) {
+            continue; // header
+        }
+        if cols.len() != 3 {
+            bail!("stdin line {}: expected 3 columns `u,v,w` for a solid, got {}: {l:?}", ln + 1, cols.len());
+        }
+        let mut vals = [0.0f64; 3];
+        for (k, c) in cols.iter().enumerate() {
+            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
+            if !(0.0..=1.0).contains(&vals[k]) {
+                bail!("stdin line {}: {} = {} is outside [0, 1]", ln + 1, ["u", "v", "w"][k], vals[k]);
+            }
+        }
+        let [u, v, w] = vals;
+        let x = s.point(u, v, w);
+        if !x.is_finite() {
+            bail!("stdin line {}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})", ln + 1);
+        }
+        writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+    }
+    out.flush()?;
+    Ok(())
 }
 
 fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {

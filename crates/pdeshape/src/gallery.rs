@@ -88,6 +88,20 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         }
     }
     for p in &scene.patches {
+        for (suffix, pic) in
+            [("sections", model::solid_sections_picture(&scene, p)), ("convergence", model::solid_convergence_plot(p))]
+        {
+            match pic {
+                Some(Ok(img)) => {
+                    let rel = format!("{name}/{name}-{}-{suffix}.png", p.name);
+                    if pdeshape_io::export::write_atomic(&dir.join(&rel), |w| img.write_png(w)).is_ok() {
+                        e.plots.push(rel);
+                    }
+                }
+                Some(Err(err)) => e.error = Some(err),
+                None => {}
+            }
+        }
         if let Some(plot) = model::convergence_plot(p) {
             match plot {
                 Ok(img) => {

@@ -41,6 +41,10 @@ pub enum Trial {
     Complete,
     /// `sin(πw) sin(nπw)`, Galerkin projection.
     Galerkin,
+    /// `sin(πw) sin(nπw)` collocated at the paper's `L·M·N` uniform interior points (a
+    /// square system): for boundary surfaces whose high derivatives are singular at the
+    /// edges of the parameter square, where the integrals of the other fits diverge.
+    Collocation,
     /// The paper's `sin²(nπw)` with uniform collocation (singular; reported).
     Paper,
 }
@@ -99,7 +103,9 @@ fn psi(trial: Trial, n: usize, w: f64, k: usize) -> f64 {
     let nf = n as f64;
     match trial {
         // sin πw sin nπw = ½[cos((n−1)πw) − cos((n+1)πw)]
-        Trial::Complete | Trial::Galerkin => 0.5 * (cos_d((nf - 1.0) * PI, w, k) - cos_d((nf + 1.0) * PI, w, k)),
+        Trial::Complete | Trial::Galerkin | Trial::Collocation => {
+            0.5 * (cos_d((nf - 1.0) * PI, w, k) - cos_d((nf + 1.0) * PI, w, k))
+        }
         // sin² nπw = ½ − ½ cos 2nπw
         Trial::Paper => (if k == 0 { 0.5 } else { 0.0 }) - 0.5 * cos_d(2.0 * nf * PI, w, k),
     }
@@ -138,10 +144,15 @@ impl SolidBlend {
         match opts.trial {
             Trial::Complete => s.solve_separated(false)?,
             Trial::Galerkin => s.solve_separated(true)?,
-            Trial::Paper => s.solve_paper()?,
+            Trial::Paper | Trial::Collocation => s.solve_collocation()?,
         }
         s.report.max_coefficient = s.a.iter().map(|x| x.x.abs().max(x.y.abs()).max(x.z.abs())).fold(0.0, f64::max);
         Ok(s)
+    }
+
+    /// The operator.
+    pub fn operator(&self) -> SolidOperator {
+        self.op
     }
 
     /// What the solve did.
@@ -227,11 +238,12 @@ impl SolidBlend {
     }
 
     #[allow(clippy::needless_range_loop)] // (l, m, n) index the coefficient tensor
-    fn solve_paper(&mut self) -> Result<(), SolidError> {
+    fn solve_collocation(&mut self) -> Result<(), SolidError> {
+        let trial = self.opts.trial;
         let (nl, nm, nn) = self.opts.terms;
         let k = nl * nm * nn;
         if k > 4096 {
-            return Err(SolidError::Input(format!("the paper's collocation with L·M·N = {k} > 4096 is too large")));
+            return Err(SolidError::Input(format!("collocation with L·M·N = {k} > 4096 is too large")));
         }
         let pts = |n: usize| -> Vec<f64> { (1..=n).map(|i| i as f64 / (n + 1) as f64).collect() };
         let (pu, pv, pw) = (pts(nl), pts(nm), pts(nn));
@@ -255,8 +267,8 @@ impl SolidBlend {
                                 let s = (lf * u).sin() * (mf * v).sin();
                                 a[(row, (l * nm + m) * nn + n)] = s
                                     * ((self.op.alpha * lf.powi(4) + self.op.beta * mf.powi(4))
-                                        * psi(Trial::Paper, n + 1, w, 0)
-                                        + self.op.gamma * psi(Trial::Paper, n + 1, w, 4));
+                                        * psi(trial, n + 1, w, 0)
+                                        + self.op.gamma * psi(trial, n + 1, w, 4));
                             }
                         }
                     }
@@ -265,10 +277,14 @@ impl SolidBlend {
             }
         }
         let cond = crate::linalg::condition_number(&a).map_err(|e| SolidError::Solve(e.to_string()))?;
-        self.report.method = "paper-collocation";
+        self.report.method = if trial == Trial::Paper { "paper-collocation" } else { "collocation" };
         self.report.condition_number = cond;
         if cond.is_nan() || cond > 1e12 {
-            return Err(SolidError::PaperSingular { cond });
+            return Err(if trial == Trial::Paper {
+                SolidError::PaperSingular { cond }
+            } else {
+                SolidError::Solve(format!("the collocation system is singular (condition number {cond:.2e})"))
+            });
         }
         let solver = crate::linalg::SquareSolver::new(&a, 1e12).map_err(|e| SolidError::Solve(e.to_string()))?;
         let x = solver.solve(&b);

@@ -87,25 +87,28 @@ impl Welder {
     }
 }
 
-/// The boundary of the solid as a closed, consistently oriented triangle mesh: the six
-/// faces of the parameter cube at `res` vertices per direction, outward (the orientation
-/// follows the sign of `det J` at the centre). Coincident vertices are welded, triangles
-/// that collapse (a face mapped onto an axis or a point) are dropped, and pairs of
-/// triangles covering the same vertices with opposite orientation — the two sides of a
-/// periodic seam, interior to the solid — are removed.
+/// The boundary of the solid as a closed, consistently oriented triangle mesh (see
+/// [`boundary_mesh_of`]).
 pub fn boundary_mesh(s: &SolidBlend, res: (usize, usize, usize)) -> Mesh {
+    boundary_mesh_of(&|u, v, w| s.point(u, v, w), res)
+}
+
+/// The boundary of any map `x: [0, 1]³ → R³` as a closed, consistently oriented triangle
+/// mesh: the six faces of the parameter cube at `res` vertices per direction. Coincident
+/// vertices are welded, triangles that collapse (a face mapped onto an axis or a point) are
+/// dropped, and pairs of triangles covering the same vertices with opposite orientation —
+/// the two sides of a periodic seam, interior to the solid — are removed. The orientation
+/// is made outward by the sign of the enclosed volume (divergence theorem).
+pub fn boundary_mesh_of(x: &(dyn Fn(f64, f64, f64) -> Vec3 + Sync), res: (usize, usize, usize)) -> Mesh {
     let (nu, nv, nw) = (res.0.max(2), res.1.max(2), res.2.max(2));
-    let [a, b, c] = s.jacobian(0.5, 0.5, 0.5);
-    let flip = a.dot(b.cross(c)) < 0.0;
-    // bounding size for the weld tolerance
-    let probe = s.grid(&[0.0, 0.5, 1.0], &[0.0, 0.5, 1.0], &[0.0, 0.5, 1.0]);
+    let probe: Vec<Vec3> =
+        (0..27).map(|i| x((i % 3) as f64 / 2.0, ((i / 3) % 3) as f64 / 2.0, (i / 9) as f64 / 2.0)).collect();
     let (lo, hi) = probe.iter().fold((probe[0], probe[0]), |(lo, hi), p| {
         (Vec3::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z)), Vec3::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z)))
     });
     let size = (hi - lo).norm().max(1e-300);
     let mut weld = Welder { tol: 1e-9 * size, cells: HashMap::new(), points: Vec::new() };
     let mut tris: Vec<[u32; 3]> = Vec::new();
-    // each face: (fixed axis, value, outward sign) with the two free axes in right-handed order
     for (axis, value) in [(0usize, 0.0), (0, 1.0), (1, 0.0), (1, 1.0), (2, 0.0), (2, 1.0)] {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
         let n = [nu, nv, nw];
@@ -117,12 +120,12 @@ pub fn boundary_mesh(s: &SolidBlend, res: (usize, usize, usize)) -> Mesh {
                 t[axis] = value;
                 t[p] = i as f64 / (np - 1) as f64;
                 t[q] = j as f64 / (nq - 1) as f64;
-                ids[i * nq + j] = weld.insert(s.point(t[0], t[1], t[2]));
+                ids[i * nq + j] = weld.insert(x(t[0], t[1], t[2]));
             }
         }
-        // (p, q, axis) is a cyclic, right-handed order: p × q points along +axis, outward at
-        // value = 1; reverse at value = 0 (and everywhere when det J < 0).
-        let reverse = (value == 0.0) != flip;
+        // (p, q, axis) is cyclic: e_p × e_q = e_axis points outward at value = 1 in the
+        // parameter cube; reversed at value = 0.
+        let reverse = value == 0.0;
         for i in 0..np - 1 {
             for j in 0..nq - 1 {
                 let (a, b, c, d) =
@@ -137,7 +140,6 @@ pub fn boundary_mesh(s: &SolidBlend, res: (usize, usize, usize)) -> Mesh {
     let area =
         |t: &[u32; 3]| (pts[t[1] as usize] - pts[t[0] as usize]).cross(pts[t[2] as usize] - pts[t[0] as usize]).norm();
     tris.retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && area(t) > 1e-14 * size * size);
-    // remove doubly covered pairs (seams)
     let mut count: HashMap<[u32; 3], usize> = HashMap::new();
     for t in &tris {
         let mut k = *t;
@@ -149,7 +151,6 @@ pub fn boundary_mesh(s: &SolidBlend, res: (usize, usize, usize)) -> Mesh {
         k.sort_unstable();
         count[&k] == 1
     });
-    // keep only the used vertices
     let mut remap = vec![u32::MAX; pts.len()];
     let mut positions = Vec::new();
     for t in tris.iter_mut() {
@@ -161,7 +162,19 @@ pub fn boundary_mesh(s: &SolidBlend, res: (usize, usize, usize)) -> Mesh {
             *i = remap[*i as usize];
         }
     }
-    // area-weighted vertex normals
+    // outward: a map with det J < 0 turns the parameter orientation inside out
+    let signed: f64 = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            a.dot(b.cross(c))
+        })
+        .sum();
+    if signed < 0.0 {
+        for t in tris.iter_mut() {
+            t.swap(1, 2);
+        }
+    }
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for t in &tris {
         let [a, b, c] = t.map(|i| positions[i as usize]);

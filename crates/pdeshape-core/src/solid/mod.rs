@@ -24,7 +24,7 @@ mod gauss;
 mod mass;
 
 pub use blend::{SolidBlend, SolidOperator, SolidOptions, SolidReport, Trial};
-pub use boundary::{boundary_mesh, cross_section, hex_mesh};
+pub use boundary::{boundary_mesh, boundary_mesh_of, cross_section, hex_mesh};
 pub use gauss::gauss_legendre;
 pub use mass::MassProperties;
 

@@ -682,15 +682,7 @@ fn build_patch(
         "pde" => PatchKind::Pde,
         "blend" => PatchKind::Blend,
         "dynamic" => PatchKind::Dynamic,
-        k @ "solid" => {
-            return Err(ctx.err(
-                span(&rp.kind),
-                format!("{key}.kind"),
-                format!(
-                    "patch kind `{k}` is not available in this version of pdeshape (available: hermite, pde, blend, dynamic)"
-                ),
-            ));
-        }
+        "solid" => PatchKind::Solid,
         k => {
             return Err(ctx.err(
                 span(&rp.kind),
@@ -700,9 +692,11 @@ fn build_patch(
         }
     };
     let only = |present: bool, name: &str, for_kind: PatchKind| -> R<()> {
-        // start/end, solver and the collocation grid serve both kinds of blend
+        // start/end, solver and the collocation grid serve both kinds of blend; β and γ
+        // serve dynamic and solid blends
         let shared = matches!(name, "start" | "end" | "solver" | "collocation" | "basis")
-            && matches!(kind, PatchKind::Blend | PatchKind::Dynamic);
+            && matches!(kind, PatchKind::Blend | PatchKind::Dynamic)
+            || matches!(name, "beta" | "gamma") && kind == PatchKind::Solid;
         if present && kind != for_kind && !shared {
             return Err(ctx.err(
                 span(p),
@@ -736,6 +730,31 @@ fn build_patch(
         (rp.frames.is_some(), "frames"),
     ] {
         only(present, name, PatchKind::Dynamic)?;
+    }
+    for (present, name) in [
+        (rp.alpha.is_some(), "alpha"),
+        (rp.trial.is_some(), "trial"),
+        (rp.lmn.is_some(), "lmn"),
+        (rp.w0.is_some(), "w0"),
+        (rp.w0_tangent.is_some(), "w0_tangent"),
+        (rp.w1.is_some(), "w1"),
+        (rp.w1_tangent.is_some(), "w1_tangent"),
+        (rp.cells.is_some(), "cells"),
+        (rp.primary.is_some(), "primary"),
+    ] {
+        only(present, name, PatchKind::Solid)?;
+    }
+    if kind == PatchKind::Solid {
+        for (present, name) in [(rp.conditions.is_some(), "conditions"), (rp.resolution.is_some(), "resolution")] {
+            if present {
+                return Err(ctx.err(
+                    span(p),
+                    format!("{key}.{name}"),
+                    format!("a solid blend takes w0, w0_tangent, w1, w1_tangent and cells instead of `{name}`"),
+                ));
+            }
+        }
+        return build_solid(ctx, pname, &key, p);
     }
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;
@@ -889,6 +908,7 @@ fn build_patch(
             dynamic = Some(setup);
             Arc::new(f)
         }
+        PatchKind::Solid => unreachable!("solid patches are built by build_solid"),
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
     Ok(ScenePatch {
@@ -902,6 +922,102 @@ fn build_patch(
         sections,
         blend,
         dynamic,
+        solid: None,
+    })
+}
+
+/// A solid blend (SPEC §6) from its four boundary surfaces.
+fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<ScenePatch> {
+    use pdeshape_core::solid::{SolidBlend, SolidOperator, SolidOptions, Trial};
+    let rp = p.get_ref();
+    let num = |x: &Option<Spanned<NumOrExpr>>, name: &str| -> R<f64> {
+        match x {
+            Some(x) => ctx.num(x.get_ref(), span(x), &format!("{key}.{name}")),
+            None => Ok(1.0),
+        }
+    };
+    let op = SolidOperator::new(num(&rp.alpha, "alpha")?, num(&rp.beta, "beta")?, num(&rp.gamma, "gamma")?)
+        .map_err(|e| ctx.err(span(p), key, e.to_string()))?;
+    let mut faces = Vec::with_capacity(4);
+    for (f, name) in [(&rp.w0, "w0"), (&rp.w0_tangent, "w0_tangent"), (&rp.w1, "w1"), (&rp.w1_tangent, "w1_tangent")] {
+        let f = f.as_ref().ok_or_else(|| {
+            ctx.err(
+                span(p),
+                format!("{key}.{name}"),
+                format!("a solid blend needs `{name}` (three expressions in u, v)"),
+            )
+        })?;
+        let field: FieldRef = Arc::new(ctx.field(f, &["u", "v"], &format!("{key}.{name}"))?);
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let (u, v) = (i as f64 / 8.0, j as f64 / 8.0);
+                if !field.eval(&[u, v]).is_finite() {
+                    return Err(ctx.err(
+                        span(f),
+                        format!("{key}.{name}"),
+                        format!("not finite at (u, v) = ({u}, {v})"),
+                    ));
+                }
+            }
+        }
+        faces.push(field);
+    }
+    let faces: [FieldRef; 4] = faces.try_into().expect("four faces");
+    let mut opts = SolidOptions::default();
+    if let Some(t) = &rp.trial {
+        opts.trial = match t.get_ref().as_str() {
+            "complete" => Trial::Complete,
+            "galerkin" => Trial::Galerkin,
+            "collocation" => Trial::Collocation,
+            "paper" => Trial::Paper,
+            w => {
+                return Err(ctx.err(
+                    span(t),
+                    format!("{key}.trial"),
+                    format!("unknown trial space `{w}` (known: complete, galerkin, collocation, paper)"),
+                ));
+            }
+        };
+    }
+    if let Some(l) = &rp.lmn {
+        let [a, b, c] = *l.get_ref();
+        if [a, b, c].iter().any(|x| !(1..=40).contains(x)) {
+            return Err(ctx.err(
+                span(l),
+                format!("{key}.lmn"),
+                format!("[{a}, {b}, {c}] is out of range (1 … 40 each)"),
+            ));
+        }
+        opts.terms = (a as usize, b as usize, c as usize);
+    }
+    let cells = match &rp.cells {
+        None => (17, 33, 17),
+        Some(c) => {
+            let [a, b, d] = *c.get_ref();
+            if [a, b, d].iter().any(|x| !(2..=400).contains(x)) || (a * b * d) as usize > MAX_VERTICES {
+                return Err(ctx.err(span(c), format!("{key}.cells"), format!("[{a}, {b}, {d}] is out of range")));
+            }
+            (a as usize, b as usize, d as usize)
+        }
+    };
+    let primary = rp.primary.as_ref().map(|x| *x.get_ref()).unwrap_or(0.5);
+    if !(primary.is_finite() && primary >= 0.0) {
+        return Err(ctx.err(None, format!("{key}.primary"), format!("{primary} is not a non-negative number")));
+    }
+    let blend = Arc::new(SolidBlend::new(op, faces.clone(), opts).map_err(|e| ctx.err(span(p), key, e.to_string()))?);
+    let surface = Arc::new(super::SolidSection { blend: blend.clone(), axis: 2, value: 0.5 });
+    Ok(ScenePatch {
+        name: pname.to_string(),
+        kind: PatchKind::Solid,
+        surface,
+        conditions: vec![],
+        resolution: (cells.0, cells.1),
+        color: rp.color.as_ref().map(|c| *c.get_ref()),
+        spectral: None,
+        sections: None,
+        blend: None,
+        dynamic: None,
+        solid: Some(super::SolidSetup { blend, faces, cells, primary }),
     })
 }
 

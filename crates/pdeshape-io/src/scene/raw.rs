@@ -149,6 +149,23 @@ pub struct RawPatch {
     pub collocation: Option<Spanned<[i64; 2]>>,
     /// Blends: explicit boundary basis functions `g_j(v)`.
     pub basis: Option<Spanned<Vec<Spanned<String>>>>,
+    /// Solid blends: α (∂u⁴); β and γ are shared with dynamic blends.
+    pub alpha: Option<Spanned<NumOrExpr>>,
+    /// Solid blends: `"complete"` (least squares), `"galerkin"` or `"paper"`.
+    pub trial: Option<Spanned<String>>,
+    /// Solid blends: terms `[L, M, N]` of the correction.
+    pub lmn: Option<Spanned<[i64; 3]>>,
+    /// Solid blends: boundary surfaces in `(u, v)`: `x(u, v, 0)`, `x_w(u, v, 0)`, `x(u, v, 1)`,
+    /// `x_w(u, v, 1)`.
+    pub w0: Option<Spanned<[NumOrExpr; 3]>>,
+    pub w0_tangent: Option<Spanned<[NumOrExpr; 3]>>,
+    pub w1: Option<Spanned<[NumOrExpr; 3]>>,
+    pub w1_tangent: Option<Spanned<[NumOrExpr; 3]>>,
+    /// Solid blends: mesh vertices `[nu, nv, nw]`.
+    pub cells: Option<Spanned<[i64; 3]>>,
+    /// Solid blends: how far the blended (primary) solids are drawn beyond the end faces,
+    /// along the cross tangents (0 hides them).
+    pub primary: Option<Spanned<f64>>,
     /// Dynamic blends: the shape parameters β, γ, λ, ρ, η.
     pub beta: Option<Spanned<NumOrExpr>>,
     pub gamma: Option<Spanned<NumOrExpr>>,
