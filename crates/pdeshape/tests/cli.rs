@@ -134,9 +134,34 @@ fn gallery_builds_an_index_with_pictures() {
 
 #[test]
 fn not_yet_available_commands_say_so() {
-    for cmd in ["bench", "serve"] {
+    for cmd in ["serve"] {
         let o = Command::cargo_bin("pdeshape").unwrap().arg(cmd).output().unwrap();
         assert_eq!(o.status.code(), Some(1));
         assert!(String::from_utf8_lossy(&o.stderr).contains("not available"));
     }
+}
+
+/// `bench --json` reproduces paper 002's Table 1 beside the published figures and the
+/// accuracy study; `--out` writes Markdown and JSON atomically.
+#[test]
+fn bench_prints_the_papers_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let o = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["bench", "--json", "--runs", "1", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let d: serde_json::Value = serde_json::from_slice(&o).unwrap();
+    let t1 = d["paper_002_table_1"].as_array().unwrap();
+    assert_eq!(t1.len(), 3);
+    assert_eq!(t1[0]["paper_seconds"], 0.597);
+    let k5 = t1[1]["max_deviation"].as_f64().unwrap();
+    assert!(k5 > 1e-4 && k5 < 1e-2, "K = 5 deviates from the closed form by {k5}");
+    assert_eq!(d["paper_002_accuracy"].as_array().unwrap().len(), 48);
+    assert!(out.with_extension("md").exists() && out.with_extension("json").exists());
 }
