@@ -819,8 +819,8 @@ pub fn solid_convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
     ))
 }
 
-/// Iso-parametric cross sections of a solid patch (w = ¼, ½, ¾ and v = ¼, ¾), drawn with
-/// the blended solids: the papers' Figs. 1b–3b.
+/// Iso-parametric cross sections of a solid patch (w = ¼, ½, ¾ and v = ¼, ¾) with their
+/// parameter lines: the papers' Figs. 1b–3b.
 pub fn solid_sections_picture(scene: &Scene, p: &ScenePatch) -> Option<Result<Image, String>> {
     let sd = p.solid.as_ref()?;
     let mut meshes = Vec::new();
@@ -830,8 +830,9 @@ pub fn solid_sections_picture(scene: &Scene, p: &ScenePatch) -> Option<Result<Im
         meshes.push(m);
     }
     let colors = vec![p.color; meshes.len()];
-    let context = solid_context(p);
-    Some(Ok(render_meshes(&meshes, &context, &colors, &scene.render)))
+    let mut r = scene.render.clone();
+    r.wireframe = true;
+    Some(Ok(render_meshes(&meshes, &[], &colors, &r)))
 }
 
 /// Diagnostics of a scene.

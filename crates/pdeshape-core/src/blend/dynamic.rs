@@ -317,7 +317,7 @@ fn extract(conds: &[&Condition]) -> (Vec<DynBasis>, Vec<Vec<Vec3>>) {
             let expanded = c.data.expressions().and_then(|(e, vars)| {
                 let vt =
                     vars.len() <= 2 && vars.first().is_none_or(|v| v == "v") && vars.get(1).is_none_or(|v| v == "t");
-                vt.then(|| expand(&e[comp]))
+                if vt { expand(&e[comp]) } else { None }
             });
             // printed terms name variables by slot: #0 is v, #1 is t
             let pretty = |k: &str| k.replace("#0", "v").replace("#1", "t");

@@ -38,35 +38,49 @@ impl Term {
     }
 }
 
-fn raw(e: &Expr) -> Vec<Term> {
+/// Largest number of raw (uncollected) terms an expansion may produce: nested powers of
+/// sums grow combinatorially, and past this size the expression is treated as opaque.
+pub const MAX_TERMS: usize = 4096;
+
+/// The expansion outgrew [`MAX_TERMS`].
+struct Overflow;
+
+fn raw(e: &Expr) -> Result<Vec<Term>, Overflow> {
     match &e.node {
-        Node::Num(c) => vec![Term { coef: *c, factors: vec![] }],
-        Node::Neg(a) => raw(a).into_iter().map(|t| Term { coef: -t.coef, ..t }).collect(),
+        Node::Num(c) => Ok(vec![Term { coef: *c, factors: vec![] }]),
+        Node::Neg(a) => Ok(raw(a)?.into_iter().map(|t| Term { coef: -t.coef, ..t }).collect()),
         Node::Bin(BinOp::Add, a, b) => {
-            let mut r = raw(a);
-            r.extend(raw(b));
-            r
+            let mut r = raw(a)?;
+            r.extend(raw(b)?);
+            if r.len() > MAX_TERMS { Err(Overflow) } else { Ok(r) }
         }
         Node::Bin(BinOp::Sub, a, b) => {
-            let mut r = raw(a);
-            r.extend(raw(b).into_iter().map(|t| Term { coef: -t.coef, ..t }));
-            r
+            let mut r = raw(a)?;
+            r.extend(raw(b)?.into_iter().map(|t| Term { coef: -t.coef, ..t }));
+            if r.len() > MAX_TERMS { Err(Overflow) } else { Ok(r) }
         }
-        Node::Bin(BinOp::Mul, a, b) => product(&raw(a), &raw(b)),
+        Node::Bin(BinOp::Mul, a, b) => product(&raw(a)?, &raw(b)?),
         Node::Bin(BinOp::Div, a, b) if b.as_constant().is_some() => {
             let c = b.as_constant().unwrap_or(1.0);
-            raw(a).into_iter().map(|t| Term { coef: t.coef / c, ..t }).collect()
+            Ok(raw(a)?.into_iter().map(|t| Term { coef: t.coef / c, ..t }).collect())
         }
         Node::Bin(BinOp::Pow, a, b) if matches!(b.as_constant(), Some(n) if n >= 0.0 && n == n.round() && n <= 8.0) => {
             let n = b.as_constant().unwrap_or(0.0) as usize;
-            let base = raw(a);
-            (0..n).fold(vec![Term { coef: 1.0, factors: vec![] }], |acc, _| product(&acc, &base))
+            let base = raw(a)?;
+            let mut acc = vec![Term { coef: 1.0, factors: vec![] }];
+            for _ in 0..n {
+                acc = product(&acc, &base)?;
+            }
+            Ok(acc)
         }
-        _ => vec![Term { coef: 1.0, factors: vec![e.clone()] }],
+        _ => Ok(vec![Term { coef: 1.0, factors: vec![e.clone()] }]),
     }
 }
 
-fn product(a: &[Term], b: &[Term]) -> Vec<Term> {
+fn product(a: &[Term], b: &[Term]) -> Result<Vec<Term>, Overflow> {
+    if a.len() * b.len() > MAX_TERMS {
+        return Err(Overflow);
+    }
     let mut out = Vec::with_capacity(a.len() * b.len());
     for x in a {
         for y in b {
@@ -75,31 +89,36 @@ fn product(a: &[Term], b: &[Term]) -> Vec<Term> {
             out.push(Term { coef: x.coef * y.coef, factors: f });
         }
     }
-    out
+    Ok(out)
 }
 
 /// Expands a (bound) expression into collected terms, in order of first appearance.
-/// Terms whose coefficients cancel exactly are dropped.
+/// Terms whose coefficients cancel exactly are dropped. `None` when the expansion would
+/// exceed [`MAX_TERMS`] raw terms (e.g. nested powers of sums): callers then treat the
+/// expression as one opaque function.
 ///
 /// ```
 /// use pdeshape_core::expr::{Expr, expand};
 /// let e = Expr::parse("(1 - t)*(2*sin(v) + 3) + t*sin(v)").unwrap().bind(&["v", "t"], &|_| None).unwrap();
-/// let terms = expand(&e);
+/// let terms = expand(&e).unwrap();
 /// let keys: Vec<String> = terms.iter().map(|t| format!("{}:{}", t.coef, t.key())).collect();
 /// assert_eq!(keys, ["2:sin(#0)", "3:1", "-1:#1*sin(#0)", "-3:#1"]);
 /// ```
-pub fn expand(e: &Expr) -> Vec<Term> {
-    let mut out: Vec<(String, Term)> = Vec::new();
-    for mut t in raw(e) {
+pub fn expand(e: &Expr) -> Option<Vec<Term>> {
+    let mut out: Vec<Term> = Vec::new();
+    let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for mut t in raw(e).ok()? {
         t.factors.sort_by_key(|f| f.to_string());
         let k = t.key();
-        if let Some((_, acc)) = out.iter_mut().find(|(key, _)| *key == k) {
-            acc.coef += t.coef;
-        } else {
-            out.push((k, t));
+        match index.get(&k) {
+            Some(&i) => out[i].coef += t.coef,
+            None => {
+                index.insert(k, out.len());
+                out.push(t);
+            }
         }
     }
-    out.into_iter().map(|(_, t)| t).filter(|t| t.coef != 0.0).collect()
+    Some(out.into_iter().filter(|t| t.coef != 0.0).collect())
 }
 
 #[cfg(test)]
@@ -110,10 +129,21 @@ mod tests {
     fn expansion_reproduces_the_expression() {
         let src = "(1 - t)*(1.5*sinh(0.5*v + 0.1) + 2*sin(3*v))^2 / 4 - t*(v - 1)*cos(-v)";
         let e = Expr::parse(src).unwrap().bind(&["v", "t"], &|_| None).unwrap();
-        let terms = expand(&e);
+        let terms = expand(&e).unwrap();
         for &(v, t) in &[(0.3, 0.2), (-1.0, 0.7), (2.5, 0.0)] {
             let s: f64 = terms.iter().map(|tm| tm.coef * tm.product().eval(&[v, t])).sum();
             assert!((s - e.eval(&[v, t])).abs() < 1e-12);
         }
+    }
+
+    /// Found by fuzzing: nested powers of sums grow combinatorially; the expansion gives up
+    /// instead of hanging.
+    #[test]
+    fn nested_powers_give_up_instead_of_exploding() {
+        let src = "-u-(-(u)^8 + a-u-(u)^8 + u)^8 + a-u-(u)^8 + a";
+        let e = Expr::parse(src).unwrap().bind(&["u"], &|n| (n == "a").then_some(1.5)).unwrap();
+        assert!(expand(&e).is_none());
+        let e = Expr::parse("(u + 1)^8").unwrap().bind(&["u"], &|_| None).unwrap();
+        assert_eq!(expand(&e).unwrap().len(), 9);
     }
 }
