@@ -40,7 +40,11 @@ impl Term {
 
 /// Largest number of raw (uncollected) terms an expansion may produce: nested powers of
 /// sums grow combinatorially, and past this size the expression is treated as opaque.
-pub const MAX_TERMS: usize = 4096;
+pub const MAX_TERMS: usize = 512;
+
+/// Largest expression (in nodes) that is expanded at all: every term clones and prints its
+/// factors, so the work grows with terms × size.
+pub const MAX_NODES: usize = 2000;
 
 /// The expansion outgrew [`MAX_TERMS`].
 struct Overflow;
@@ -94,7 +98,8 @@ fn product(a: &[Term], b: &[Term]) -> Result<Vec<Term>, Overflow> {
 
 /// Expands a (bound) expression into collected terms, in order of first appearance.
 /// Terms whose coefficients cancel exactly are dropped. `None` when the expansion would
-/// exceed [`MAX_TERMS`] raw terms (e.g. nested powers of sums): callers then treat the
+/// exceed [`MAX_TERMS`] raw terms (e.g. nested powers of sums) or the expression has more
+/// than [`MAX_NODES`] nodes: callers then treat the
 /// expression as one opaque function.
 ///
 /// ```
@@ -105,6 +110,11 @@ fn product(a: &[Term], b: &[Term]) -> Result<Vec<Term>, Overflow> {
 /// assert_eq!(keys, ["2:sin(#0)", "3:1", "-1:#1*sin(#0)", "-3:#1"]);
 /// ```
 pub fn expand(e: &Expr) -> Option<Vec<Term>> {
+    let mut nodes = 0usize;
+    e.visit(&mut |_| nodes += 1);
+    if nodes > MAX_NODES {
+        return None;
+    }
     let mut out: Vec<Term> = Vec::new();
     let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     for mut t in raw(e).ok()? {
@@ -145,5 +155,9 @@ mod tests {
         assert!(expand(&e).is_none());
         let e = Expr::parse("(u + 1)^8").unwrap().bind(&["u"], &|_| None).unwrap();
         assert_eq!(expand(&e).unwrap().len(), 9);
+        // and long expressions with many products are not expanded at all
+        let long = include_str!("fuzz_regression_expand_long.txt").trim();
+        let e = Expr::parse(long).unwrap().bind(&["u", "v", "t"], &|_| None).unwrap();
+        assert!(expand(&e).is_none());
     }
 }
