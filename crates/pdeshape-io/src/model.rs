@@ -35,7 +35,7 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
         add_continuity_fields(&mut m, p, b.blend.as_ref());
     }
     if let Some(d) = &p.dynamic {
-        m.animation = Some(dynamic_animation(p, d, nu, nv)?);
+        m.animation = Some(dynamic_animation(p, d)?);
     }
     m.check_finite()?;
     Ok(m)
@@ -46,14 +46,11 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
 fn dynamic_animation(
     p: &ScenePatch,
     d: &crate::scene::DynamicSetup,
-    nu: usize,
-    nv: usize,
 ) -> Result<pdeshape_core::mesh::MorphAnimation, String> {
     let times = d.frame_times();
     let mut anim = pdeshape_core::mesh::MorphAnimation { times: times.clone(), positions: vec![], normals: vec![] };
     for &t in &times {
-        let f = d.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
-        let fm = grid_mesh(&f, &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+        let fm = frame_mesh(p, d, t)?;
         anim.positions.push(fm.positions);
         anim.normals.push(fm.normals);
     }
@@ -63,12 +60,10 @@ fn dynamic_animation(
 /// The frame meshes of a dynamic patch (`None` for other patches), named `PATCH-NNN`.
 pub fn frame_meshes(p: &ScenePatch) -> Option<Result<Vec<Mesh>, String>> {
     let d = p.dynamic.as_ref()?;
-    let (nu, nv) = p.resolution;
     let run = || -> Result<Vec<Mesh>, String> {
         let mut out = Vec::new();
         for (i, t) in d.frame_times().into_iter().enumerate() {
-            let f = d.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
-            let mut m = grid_mesh(&f, &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
+            let mut m = frame_mesh(p, d, t)?;
             m.name = format!("{}-{i:03}", p.name);
             m.check_finite()?;
             out.push(m);
@@ -268,29 +263,13 @@ pub fn dynamic_strip(scene: &Scene) -> Option<Result<Image, String>> {
             let mut meshes = Vec::new();
             for p in &scene.patches {
                 match &p.dynamic {
-                    Some(dy) => {
-                        let f = dy.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
-                        let mut m = grid_mesh(&f, &GridOptions::new(p.resolution.0, p.resolution.1))
-                            .map_err(|e| format!("patch `{}`: {e}", p.name))?;
-                        m.name = p.name.clone();
-                        meshes.push(m);
-                    }
+                    Some(dy) => meshes.push(frame_mesh(p, dy, t)?),
                     None => meshes.push(patch_mesh(p)?),
                 }
             }
             let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
             let img = render_meshes(&meshes, &context, &colors, &r);
-            let mut panel = Image::new(img.width, img.height + 34, [255, 255, 255]);
-            panel.paste(&img, 0, 0);
-            crate::render::draw_text(
-                &mut panel,
-                10.0,
-                img.height as f32 + 4.0,
-                22.0,
-                &format!("t = {t:.2}"),
-                [30, 30, 40],
-            );
-            panels.push(panel);
+            panels.push(captioned(&img, &format!("t = {t:.2}"), 34, 22.0));
         }
         Ok(Image::strip(&panels, 4, [255, 255, 255]))
     };
@@ -312,23 +291,30 @@ pub fn study_strip(scene: &Scene, study: &crate::scene::Study) -> Result<Image, 
         let mut r = sc.render.clone();
         r.size = (360, 420);
         let img = render_meshes(&patches, &context, &colors, &r);
-        let mut panel = Image::new(img.width, img.height + 34, [255, 255, 255]);
-        panel.paste(&img, 0, 0);
-        crate::render::draw_text(
-            &mut panel,
-            10.0,
-            img.height as f32 + 4.0,
-            22.0,
-            &format!("{} = {x}", study.vary),
-            [30, 30, 40],
-        );
-        panels.push(panel);
+        panels.push(captioned(&img, &format!("{} = {x}", study.vary), 34, 22.0));
     }
     let strip = Image::strip(&panels, 4, [255, 255, 255]);
     let mut out = Image::new(strip.width, strip.height + 40, [255, 255, 255]);
     out.paste(&strip, 0, 40);
     crate::render::draw_text(&mut out, 10.0, 6.0, 24.0, &study.title, [20, 20, 30]);
     Ok(out)
+}
+
+/// `img` with `text` printed under it on a white band.
+fn captioned(img: &Image, text: &str, band: u32, size: f32) -> Image {
+    let mut panel = Image::new(img.width, img.height + band, [255, 255, 255]);
+    panel.paste(img, 0, 0);
+    crate::render::draw_text(&mut panel, 10.0, img.height as f32 + 4.0, size, text, [30, 30, 40]);
+    panel
+}
+
+/// The mesh of a dynamic patch's frame at time `t`, at the patch's resolution.
+fn frame_mesh(p: &ScenePatch, dy: &crate::scene::DynamicSetup, t: f64) -> Result<Mesh, String> {
+    let f = dy.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+    let mut m = grid_mesh(&f, &GridOptions::new(p.resolution.0, p.resolution.1))
+        .map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+    m.name = p.name.clone();
+    Ok(m)
 }
 
 fn palette(k: usize) -> [f64; 3] {

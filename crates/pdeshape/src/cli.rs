@@ -441,12 +441,17 @@ fn execute(cli: Cli) -> Result<()> {
     }
 }
 
-/// `u,v,w` from stdin to `u,v,w,x,y,z` for a solid blend.
-fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
+/// Reads CSV rows of `N` finite numbers from stdin (a header line and `#` comments are
+/// skipped) and writes `header` then one line per row from `f`; errors name the line.
+fn sample_rows<const N: usize>(
+    header: &str,
+    mut f: impl FnMut(usize, [f64; N], &mut dyn Write) -> Result<()>,
+) -> Result<()> {
+    let names = header.split(',').take(N).collect::<Vec<_>>().join(",");
     let stdin = std::io::stdin();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    writeln!(out, "u,v,w,x,y,z")?;
+    writeln!(out, "{header}")?;
     for (ln, line) in stdin.lock().lines().enumerate() {
         let line = line.context("cannot read stdin")?;
         let l = line.trim();
@@ -457,66 +462,54 @@ fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
         if ln == 0 && cols.first().is_some_and(|c| c.parse::<f64>().is_err()) {
             continue; // header
         }
-        if cols.len() != 3 {
-            bail!("stdin line {}: expected 3 columns `u,v,w` for a solid, got {}: {l:?}", ln + 1, cols.len());
+        if cols.len() != N {
+            bail!("stdin line {}: expected {N} columns `{names}`, got {}: {l:?}", ln + 1, cols.len());
         }
-        let mut vals = [0.0f64; 3];
-        for (k, c) in cols.iter().enumerate() {
-            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
-            if !(0.0..=1.0).contains(&vals[k]) {
-                bail!("stdin line {}: {} = {} is outside [0, 1]", ln + 1, ["u", "v", "w"][k], vals[k]);
-            }
-        }
-        let [u, v, w] = vals;
-        let x = s.point(u, v, w);
-        if !x.is_finite() {
-            bail!("stdin line {}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})", ln + 1);
-        }
-        writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
-    }
-    out.flush()?;
-    Ok(())
-}
-
-fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {
-    let stdin = std::io::stdin();
-    let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::new(stdout.lock());
-    let dom = surface.v_domain();
-    writeln!(out, "u,v,x,y,z")?;
-    for (ln, line) in stdin.lock().lines().enumerate() {
-        let line = line.context("cannot read stdin")?;
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
-        if ln == 0 && cols.first().is_some_and(|c| c.parse::<f64>().is_err()) {
-            continue; // header
-        }
-        if cols.len() != 2 {
-            bail!("stdin line {}: expected 2 columns `u,v`, got {}: {l:?}", ln + 1, cols.len());
-        }
-        let mut vals = [0.0f64; 2];
+        let mut vals = [0.0f64; N];
         for (k, c) in cols.iter().enumerate() {
             vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
             if !vals[k].is_finite() {
                 bail!("stdin line {}: `{c}` is not finite", ln + 1);
             }
         }
-        let [u, v] = vals;
-        if !(0.0..=1.0).contains(&u) {
-            bail!("stdin line {}: u = {u} is outside [0, 1]", ln + 1);
-        }
-        if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
-            bail!("stdin line {}: v = {v} is outside [{}, {}]", ln + 1, dom.start, dom.end);
-        }
-        let x = surface.point(u, v);
-        if !x.is_finite() {
-            bail!("stdin line {}: the patch is not finite at (u, v) = ({u}, {v})", ln + 1);
-        }
-        writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+        f(ln + 1, vals, &mut out)?;
     }
     out.flush()?;
     Ok(())
+}
+
+/// `u,v,w` from stdin to `u,v,w,x,y,z` for a solid blend.
+fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
+    sample_rows("u,v,w,x,y,z", |ln, [u, v, w], out| {
+        for (name, x) in [("u", u), ("v", v), ("w", w)] {
+            if !(0.0..=1.0).contains(&x) {
+                bail!("stdin line {ln}: {name} = {x} is outside [0, 1]");
+            }
+        }
+        let x = s.point(u, v, w);
+        if !x.is_finite() {
+            bail!("stdin line {ln}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})");
+        }
+        writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+        Ok(())
+    })
+}
+
+/// `u,v` from stdin to `u,v,x,y,z` for a patch.
+fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {
+    let dom = surface.v_domain();
+    sample_rows("u,v,x,y,z", |ln, [u, v], out| {
+        if !(0.0..=1.0).contains(&u) {
+            bail!("stdin line {ln}: u = {u} is outside [0, 1]");
+        }
+        if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
+            bail!("stdin line {ln}: v = {v} is outside [{}, {}]", dom.start, dom.end);
+        }
+        let x = surface.point(u, v);
+        if !x.is_finite() {
+            bail!("stdin line {ln}: the patch is not finite at (u, v) = ({u}, {v})");
+        }
+        writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+        Ok(())
+    })
 }

@@ -7,7 +7,7 @@ use crate::expr::{Expr, expand};
 use crate::jet::{Jet, JetShape};
 use crate::linalg::{least_squares, least_squares_min_norm};
 use crate::ode::{Cardinal, CondSpec, ExpSpace};
-use crate::patch::{Condition, Surface, VDomain};
+use crate::patch::{Condition, Surface, VDomain, cubic_hermite};
 use faer::Mat;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -225,17 +225,6 @@ pub fn zeta(k: usize, u: f64) -> [f64; 5] {
     let xi4 = [u * u * u - u * u, 3.0 * u * u - 2.0 * u, 6.0 * u - 2.0, 6.0, 0.0];
     let sine = [s, w * c, -w * w * s, -w * w * w * c, w * w * w * w * s];
     std::array::from_fn(|i| sine[i] - w * (xi2[i] + sg * xi4[i]))
-}
-
-/// The cubic Hermite functions `ξ₁ … ξ₄` and their derivatives up to order 4.
-fn hermite(u: f64) -> [[f64; 5]; 4] {
-    let (u2, u3) = (u * u, u * u * u);
-    [
-        [1.0 - 3.0 * u2 + 2.0 * u3, -6.0 * u + 6.0 * u2, -6.0 + 12.0 * u, 12.0, 0.0],
-        [u - 2.0 * u2 + u3, 1.0 - 4.0 * u + 3.0 * u2, -4.0 + 6.0 * u, 6.0, 0.0],
-        [3.0 * u2 - 2.0 * u3, 6.0 * u - 6.0 * u2, 6.0 - 12.0 * u, -12.0, 0.0],
-        [u3 - u2, 3.0 * u2 - 2.0 * u, 6.0 * u - 2.0, 6.0, 0.0],
-    ]
 }
 
 /// Options of a dynamic blend.
@@ -493,7 +482,7 @@ impl DynamicBlend {
         let fd: Vec<Vec<FDerivs>> =
             vs.iter().map(|&v| partials_all(&self.basis, v, t, 4, 2).iter().map(|p| fderivs(p)).collect()).collect();
         let z: Vec<Vec<[f64; 5]>> = us.iter().map(|&u| (1..=k).map(|kk| zeta(kk, u)).collect()).collect();
-        let h: Vec<[[f64; 5]; 4]> = us.iter().map(|&u| hermite(u)).collect();
+        let h: Vec<[[f64; 5]; 4]> = us.iter().map(|&u| cubic_hermite(u)).collect();
         // Hermite part of G_j at u_l (derivatives 0..4), per component
         let hpart = |l: usize, j: usize| -> [Vec3; 5] {
             let ww = w(j);
@@ -623,7 +612,7 @@ impl Profile {
             }
             Profile::Poly { w, p } => {
                 assert!(kmax <= 4, "collocation profiles are evaluated up to the 4th derivative");
-                let h = hermite(u);
+                let h = cubic_hermite(u);
                 let z: Vec<[f64; 5]> = (1..=p.len()).map(|k| zeta(k, u)).collect();
                 (0..=kmax)
                     .map(|i| {

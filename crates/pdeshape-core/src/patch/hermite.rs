@@ -158,6 +158,25 @@ impl Surface for HermitePatch {
     }
 }
 
+/// The cubic Hermite functions `h₀₀ = 1 − 3u² + 2u³`, `h₁₀ = u(1 − u)²`, `h₀₁ = u²(3 − 2u)`,
+/// `h₁₁ = u²(u − 1)` (value and slope at 0, value and slope at 1) and their derivatives:
+/// `out[i][k] = h_i^{(k)}(u)`, `k ≤ 4`.
+///
+/// ```
+/// use pdeshape_core::patch::cubic_hermite;
+/// let h = cubic_hermite(1.0);
+/// assert_eq!([h[0][0], h[1][1], h[2][0], h[3][1]], [0.0, 0.0, 1.0, 1.0]);
+/// ```
+pub fn cubic_hermite(u: f64) -> [[f64; 5]; 4] {
+    let (u2, u3) = (u * u, u * u * u);
+    [
+        [1.0 - 3.0 * u2 + 2.0 * u3, -6.0 * u + 6.0 * u2, -6.0 + 12.0 * u, 12.0, 0.0],
+        [u - 2.0 * u2 + u3, 1.0 - 4.0 * u + 3.0 * u2, -4.0 + 6.0 * u, 6.0, 0.0],
+        [3.0 * u2 - 2.0 * u3, 6.0 * u - 6.0 * u2, 6.0 - 12.0 * u, -12.0, 0.0],
+        [u3 - u2, 3.0 * u2 - 2.0 * u, 6.0 * u - 2.0, 6.0, 0.0],
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@
 mod hermite;
 mod primary;
 
-pub use hermite::{HermiteBasis, HermitePatch, HermitePatchError, Poly};
+pub use hermite::{HermiteBasis, HermitePatch, HermitePatchError, Poly, cubic_hermite};
 pub use primary::PrimarySurface;
 
 use crate::Vec3;

@@ -4,6 +4,7 @@ use super::{SolidError, gauss_legendre};
 use crate::Vec3;
 use crate::data::FieldRef;
 use crate::jet::JetShape;
+use crate::patch::cubic_hermite;
 use faer::Mat;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -75,17 +76,6 @@ pub struct SolidReport {
     pub condition_number: f64,
     /// Largest |a_lmn| (per component).
     pub max_coefficient: f64,
-}
-
-/// The cubic Hermite functions `h₀₀, h₁₀, h₀₁, h₁₁` and derivatives (index `[i][k]`).
-fn hermite(w: f64) -> [[f64; 5]; 4] {
-    let (w2, w3) = (w * w, w * w * w);
-    [
-        [1.0 - 3.0 * w2 + 2.0 * w3, -6.0 * w + 6.0 * w2, -6.0 + 12.0 * w, 12.0, 0.0],
-        [w - 2.0 * w2 + w3, 1.0 - 4.0 * w + 3.0 * w2, -4.0 + 6.0 * w, 6.0, 0.0],
-        [3.0 * w2 - 2.0 * w3, 6.0 * w - 6.0 * w2, 6.0 - 12.0 * w, -12.0, 0.0],
-        [w3 - w2, 3.0 * w2 - 2.0 * w, 6.0 * w - 2.0, 6.0, 0.0],
-    ]
 }
 
 /// `d^k/dx^k sin(cx)`.
@@ -186,7 +176,7 @@ impl SolidBlend {
         let (xw, ww) = gauss_legendre(2 * nn + 24);
         let p0: Vec<Vec<f64>> = xw.iter().map(|&w| (1..=nn).map(|n| psi(Trial::Complete, n, w, 0)).collect()).collect();
         let p4: Vec<Vec<f64>> = xw.iter().map(|&w| (1..=nn).map(|n| psi(Trial::Complete, n, w, 4)).collect()).collect();
-        let hs: Vec<[[f64; 5]; 4]> = xw.iter().map(|&w| hermite(w)).collect();
+        let hs: Vec<[[f64; 5]; 4]> = xw.iter().map(|&w| cubic_hermite(w)).collect();
         // u, v: ∫∫ R_f sin lπu sin mπv
         let (xu, wu) = gauss_legendre(3 * nl + 24);
         let (xv, wv) = gauss_legendre(3 * nm + 24);
@@ -254,7 +244,7 @@ impl SolidBlend {
             for &v in &pv {
                 let rf = self.face_residuals(u, v);
                 for &w in &pw {
-                    let h = hermite(w);
+                    let h = cubic_hermite(w);
                     let lh = (0..4).fold(Vec3::ZERO, |acc, f| acc + rf[f] * h[f][0]);
                     for c in 0..3 {
                         b[(row, c)] = -lh[c];
@@ -301,7 +291,7 @@ impl SolidBlend {
         let (nl, nm, nn) = self.opts.terms;
         let idx = |a: usize, b: usize, c: usize| (a * (dv + 1) + b) * (dw + 1) + c;
         let mut out = vec![Vec3::ZERO; (du + 1) * (dv + 1) * (dw + 1)];
-        let h = hermite(w);
+        let h = cubic_hermite(w);
         for (f, face) in self.faces.iter().enumerate() {
             let j = face.jet(&[u, v], JetShape::new(&[du, dv]));
             for a in 0..=du {
@@ -361,7 +351,7 @@ impl SolidBlend {
     /// contraction: faces once per `(u, v)`, the correction as `Σ_n C_n(u, v) ψ_n(w)`.
     pub fn grid(&self, us: &[f64], vs: &[f64], ws: &[f64]) -> Vec<Vec3> {
         let (nl, nm, nn) = self.opts.terms;
-        let hs: Vec<[[f64; 5]; 4]> = ws.iter().map(|&w| hermite(w)).collect();
+        let hs: Vec<[[f64; 5]; 4]> = ws.iter().map(|&w| cubic_hermite(w)).collect();
         let ps: Vec<Vec<f64>> = ws.iter().map(|&w| (1..=nn).map(|n| psi(self.opts.trial, n, w, 0)).collect()).collect();
         let sv: Vec<Vec<f64>> = vs.iter().map(|&v| (1..=nm).map(|m| (m as f64 * PI * v).sin()).collect()).collect();
         us.par_iter()

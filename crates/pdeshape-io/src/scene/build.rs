@@ -80,6 +80,34 @@ impl Ctx<'_> {
         self.src.error(span, key, msg)
     }
 
+    /// The solver of a blend: the command line's override, else the scene's `solver`.
+    fn solver_choice(&self, raw: &Option<Spanned<String>>, key: &str) -> R<Option<Solver>> {
+        let scene = match raw {
+            None => None,
+            Some(sv) => Some(Solver::parse(sv.get_ref()).ok_or_else(|| {
+                self.err(
+                    span(sv),
+                    format!("{key}.solver"),
+                    format!("unknown solver `{}` (known: auto, exact, collocation)", sv.get_ref()),
+                )
+            })?),
+        };
+        Ok(self.solver.or(scene))
+    }
+
+    /// Explicit basis functions: expressions in `vars`, with their source text.
+    fn basis_exprs(&self, list: &Spanned<Vec<Spanned<String>>>, key: &str, vars: &[&str]) -> R<Vec<(Expr, String)>> {
+        let mut out = Vec::new();
+        for (j, t) in list.get_ref().iter().enumerate() {
+            let text = t.get_ref();
+            let bk = format!("{key}.basis[{j}]");
+            let e = Expr::parse(text).map_err(|e| self.expr_err(span(t), &bk, text, &e))?;
+            let e = e.bind(vars, &self.param_lookup()).map_err(|e| self.expr_err(span(t), &bk, text, &e))?;
+            out.push((e, text.clone()));
+        }
+        Ok(out)
+    }
+
     fn param_lookup(&self) -> impl Fn(&str) -> Option<f64> + '_ {
         |n: &str| self.params.get(n).map(|p| p.value)
     }
@@ -1054,17 +1082,8 @@ fn build_dynamic(
         Some(f) => ctx.int(f, 2, 1000, &format!("{key}.frames"))? as usize,
     };
     let mut opts = DynamicOptions { times, ..Default::default() };
-    if let Some(sv) = &rp.solver {
-        opts.solver = Solver::parse(sv.get_ref()).ok_or_else(|| {
-            ctx.err(
-                span(sv),
-                format!("{key}.solver"),
-                format!("unknown solver `{}` (known: auto, exact, collocation)", sv.get_ref()),
-            )
-        })?;
-    }
-    if let Some(s) = ctx.solver {
-        opts.solver = s;
+    if let Some(sv) = ctx.solver_choice(&rp.solver, key)? {
+        opts.solver = sv;
     }
     if let Some(k) = &rp.terms {
         opts.terms = ctx.int(k, 1, 60, &format!("{key}.terms"))? as usize;
@@ -1085,15 +1104,8 @@ fn build_dynamic(
     }
     opts.joint = rp.joint.as_ref().map(|j| *j.get_ref()).unwrap_or(false);
     if let Some(list) = &rp.basis {
-        let mut basis = Vec::new();
-        for (j, t) in list.get_ref().iter().enumerate() {
-            let text = t.get_ref();
-            let bk = format!("{key}.basis[{j}]");
-            let e = Expr::parse(text).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
-            let e = e.bind(&["v", "t"], &ctx.param_lookup()).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
-            basis.push(DynBasis::Expr { expr: e, text: text.clone() });
-        }
-        opts.basis = Some(basis);
+        let exprs = ctx.basis_exprs(list, key, &["v", "t"])?;
+        opts.basis = Some(exprs.into_iter().map(|(expr, text)| DynBasis::Expr { expr, text }).collect());
     }
     let blend = DynamicBlend::new(op, conditions, domain, &opts)
         .map_err(|e| ctx.err(conds_span.or(Some(p.span())), key, e.to_string()))?;
@@ -1156,17 +1168,8 @@ fn build_blend(
     }
     let ops: [Operator; 3] = ops.try_into().expect("three operators");
     let mut options = BlendOptions::default();
-    if let Some(sv) = &rp.solver {
-        options.solver = Solver::parse(sv.get_ref()).ok_or_else(|| {
-            ctx.err(
-                span(sv),
-                format!("{key}.solver"),
-                format!("unknown solver `{}` (known: auto, exact, collocation)", sv.get_ref()),
-            )
-        })?;
-    }
-    if let Some(s) = ctx.solver {
-        options.solver = s;
+    if let Some(sv) = ctx.solver_choice(&rp.solver, key)? {
+        options.solver = sv;
     }
     if let Some(b) = &rp.bubbles {
         options.bubbles = ctx.int(b, 1, 40, &format!("{key}.bubbles"))? as usize;
@@ -1183,15 +1186,8 @@ fn build_blend(
         options.collocation = Some((l as usize, q as usize));
     }
     if let Some(list) = &rp.basis {
-        let mut basis = Vec::new();
-        for (j, t) in list.get_ref().iter().enumerate() {
-            let text = t.get_ref();
-            let bk = format!("{key}.basis[{j}]");
-            let e = Expr::parse(text).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
-            let e = e.bind(&["v"], &ctx.param_lookup()).map_err(|e| ctx.expr_err(span(t), &bk, text, &e))?;
-            basis.push(BasisFn::Expr { expr: e, text: text.clone() });
-        }
-        options.basis = Some(basis);
+        let exprs = ctx.basis_exprs(list, key, &["v"])?;
+        options.basis = Some(exprs.into_iter().map(|(expr, text)| BasisFn::Expr { expr, text }).collect());
     }
     let blend = StaticBlend::new(ops, conditions, domain, &options)
         .map_err(|e| ctx.err(conds_span.or(Some(p.span())), key, e.to_string()))?;
