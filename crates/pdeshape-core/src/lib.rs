@@ -9,7 +9,8 @@
 //! - [`jet`], [`expr`]: exact derivatives and the expression language of boundary data;
 //! - [`data`]: boundary data — curves, primary surfaces, Fourier analysis (SPEC §2);
 //! - [`patch`]: the patch abstraction and the ruled/Hermite patch;
-//! - [`mesh`]: structured grid meshes with analytic normals (SPEC §8).
+//! - [`mesh`]: structured grid meshes with analytic normals (SPEC §8);
+//! - [`trim`]: trimming by curves in the parameter domain (SPEC §7).
 //!
 //! This crate has no CLI, server or file-format dependencies.
 
@@ -25,6 +26,7 @@ pub mod ode;
 pub mod patch;
 pub mod solid;
 pub mod spectral;
+pub mod trim;
 mod vec3;
 
 pub use vec3::Vec3;

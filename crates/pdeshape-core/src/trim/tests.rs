@@ -1,0 +1,312 @@
+use super::*;
+use proptest::prelude::*;
+use std::f64::consts::TAU;
+
+const UNIT: Rect = Rect { min: [0.0, 0.0], max: [1.0, 1.0] };
+
+fn region(curves: Vec<(&str, TrimCurve)>) -> TrimRegion {
+    TrimRegion::new(UNIT, curves.into_iter().map(|(n, c)| (n.to_string(), c)).collect()).unwrap()
+}
+
+/// Distance from `p` to the trim loop (curves exactly, bridges as segments).
+fn loop_distance(r: &TrimRegion, p: Uv) -> f64 {
+    let mut d = r.curves.iter().map(|(_, c)| c.closest(p).1).fold(f64::INFINITY, f64::min);
+    for piece in &r.pieces {
+        if let Piece::Segment { a, b } = piece {
+            d = d.min(super::curve::distance_to_segment(p, *a, *b));
+        }
+    }
+    d
+}
+
+fn on_border(p: Uv) -> bool {
+    p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0
+}
+
+/// Everything the trimmed grid promises: boundary rings on the loop (1e-10) and on the
+/// border (exactly), no fold, no interior vertex in a hole (fine polygonisation).
+fn assert_valid(r: &TrimRegion, g: &TrimGrid) {
+    assert_eq!(g.report.folds_after, 0);
+    assert_eq!(count_folds(&g.points, g.rings, g.columns), 0);
+    for j in 0..g.columns {
+        let p = g.points[j];
+        assert!(loop_distance(r, p) < 1e-10, "ring 0, column {j}: {p:?} is {} off", loop_distance(r, p));
+        assert!(on_border(g.points[(g.rings - 1) * g.columns + j]));
+    }
+    let fine: Vec<Vec<Uv>> =
+        r.curves.iter().map(|(_, c)| c.polygonize(512).into_iter().map(|x| x.1).collect()).collect();
+    for p in &g.points[g.columns..] {
+        for poly in &fine {
+            assert!(!inside_polygon(*p, poly) || distance_to_polygon(*p, poly) < 1e-9, "{p:?} is inside a trim");
+        }
+    }
+}
+
+fn opts(rings: usize, columns: usize) -> TrimOptions {
+    TrimOptions { rings, columns, ..Default::default() }
+}
+
+#[test]
+fn circle_boundary_is_exact_at_any_phi() {
+    let r = region(vec![("c", TrimCurve::ellipse([0.45, 0.55], [0.2, 0.2]))]);
+    let map = LaplaceMap::new(r, 12, None);
+    let mut rng = 0x1234_5678_u64;
+    for _ in 0..1000 {
+        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let phi = (rng >> 11) as f64 / (1u64 << 53) as f64 * TAU;
+        let (a, b) = (map.eval(0.0, phi), map.inner(phi));
+        assert!((a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13);
+        assert!((((a[0] - 0.45).hypot(a[1] - 0.55)) - 0.2).abs() < 1e-13);
+        let (a, b) = (map.eval(1.0, phi), map.outer(phi));
+        assert!((a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13);
+        assert!(on_border(b));
+    }
+}
+
+#[test]
+fn grid_matches_pointwise_evaluation() {
+    let r = region(vec![("c", TrimCurve::ellipse([0.5, 0.5], [0.25, 0.15]))]);
+    let map = LaplaceMap::new(r, 10, Some(24));
+    let g = map.grid(7, 24);
+    for i in 0..7 {
+        for j in 0..24 {
+            let m = map.eval(i as f64 / 6.0, TAU * j as f64 / 24.0);
+            let q = g[i * 24 + j];
+            assert!((m[0] - q[0]).abs() < 1e-13 && (m[1] - q[1]).abs() < 1e-13);
+        }
+    }
+}
+
+#[test]
+fn circular_trim_meshes_without_folds_and_keeps_the_corners() {
+    let r = region(vec![("c", TrimCurve::ellipse([0.5, 0.5], [0.2, 0.2]))]);
+    let map = LaplaceMap::new(r.clone(), 12, Some(40));
+    let g = trim_grid(&map, &opts(20, 40)).unwrap();
+    assert_valid(&r, &g);
+    assert_eq!(g.report.folds_before, 0);
+    assert_eq!(g.report.sweeps, 0);
+    let last = &g.points[19 * 40..];
+    for c in UNIT.corners() {
+        assert!(last.contains(&c), "corner {c:?} is not a mesh vertex");
+    }
+    assert!((g.report.area_ratio - 1.0).abs() < 0.01, "{:?}", g.report);
+}
+
+#[test]
+fn polygon_vertices_are_mesh_vertices() {
+    let v = [[0.3, 0.3], [0.7, 0.35], [0.6, 0.7], [0.35, 0.6]];
+    let r = region(vec![("p", TrimCurve::polygon(&v).unwrap())]);
+    let map = LaplaceMap::new(r.clone(), 12, Some(48));
+    let g = trim_grid(&map, &opts(16, 48)).unwrap();
+    assert_valid(&r, &g);
+    for q in v {
+        assert!(g.points[..48].iter().any(|p| (p[0] - q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12), "{q:?}");
+    }
+}
+
+/// The paper's Fig. 6: a non-convex spline.
+fn nonconvex() -> TrimCurve {
+    TrimCurve::bspline(&[
+        [0.25, 0.25],
+        [0.5, 0.2],
+        [0.75, 0.25],
+        [0.8, 0.5],
+        [0.75, 0.75],
+        [0.55, 0.7],
+        [0.5, 0.45],
+        [0.45, 0.7],
+        [0.25, 0.75],
+        [0.2, 0.5],
+    ])
+    .unwrap()
+}
+
+#[test]
+fn nonconvex_trim_is_repaired() {
+    let r = region(vec![("n", nonconvex())]);
+    let map = LaplaceMap::new(r.clone(), 12, Some(64));
+    let g = trim_grid(&map, &opts(20, 64)).unwrap();
+    assert_valid(&r, &g);
+}
+
+#[test]
+fn disjoint_trims_are_bridged_into_one_loop() {
+    // three curves side by side, as in paper 003 Fig. 7
+    let r = region(vec![
+        ("a", TrimCurve::ellipse([0.2, 0.45], [0.1, 0.15])),
+        ("b", TrimCurve::bspline(&[[0.4, 0.4], [0.6, 0.35], [0.6, 0.6], [0.5, 0.7], [0.4, 0.6]]).unwrap()),
+        ("c", TrimCurve::ellipse([0.8, 0.55], [0.1, 0.12])),
+    ]);
+    assert_eq!(r.bridges.len(), 2);
+    let segments = r.pieces.iter().filter(|p| matches!(p, Piece::Segment { .. })).count();
+    assert_eq!(segments, 4, "each bridge is traversed both ways");
+    let map = LaplaceMap::new(r.clone(), 16, Some(96));
+    let g = trim_grid(&map, &opts(24, 96)).unwrap();
+    assert_valid(&r, &g);
+}
+
+#[test]
+fn invalid_trims_are_refused() {
+    let make = |c: Vec<(&str, TrimCurve)>| {
+        TrimRegion::new(UNIT, c.into_iter().map(|(n, c)| (n.to_string(), c)).collect()).unwrap_err()
+    };
+    let e = make(vec![("big", TrimCurve::ellipse([0.5, 0.5], [0.6, 0.2]))]);
+    assert!(matches!(e, TrimError::LeavesDomain { .. }), "{e}");
+    assert!(e.to_string().contains("`big` leaves the parameter domain"), "{e}");
+    // a bow tie crosses itself
+    let bow = TrimCurve::polygon(&[[0.2, 0.2], [0.8, 0.8], [0.8, 0.2], [0.2, 0.8]]).unwrap();
+    assert!(matches!(make(vec![("bow", bow)]), TrimError::SelfIntersection { .. }));
+    let e = make(vec![
+        ("a", TrimCurve::ellipse([0.4, 0.5], [0.2, 0.2])),
+        ("b", TrimCurve::ellipse([0.6, 0.5], [0.2, 0.2])),
+    ]);
+    assert!(matches!(e, TrimError::CurvesIntersect { .. }), "{e}");
+    let e = make(vec![
+        ("out", TrimCurve::ellipse([0.5, 0.5], [0.3, 0.3])),
+        ("in", TrimCurve::ellipse([0.5, 0.5], [0.1, 0.1])),
+    ]);
+    assert!(matches!(e, TrimError::Nested { .. }), "{e}");
+    let flat = TrimCurve::polygon(&[[0.2, 0.5], [0.5, 0.5], [0.8, 0.5]]).unwrap();
+    let e = make(vec![("flat", flat)]);
+    assert!(matches!(e, TrimError::Degenerate { .. } | TrimError::SelfIntersection { .. }), "{e}");
+}
+
+#[test]
+fn curve_on_surface_has_exact_derivatives() {
+    use crate::Vec3;
+    use crate::data::Field;
+    use crate::jet::JetShape;
+    use crate::patch::{Surface, VDomain};
+    // X(u, v) = (u, v, u² v), C(t) = (0.5 + 0.2 cos t, 0.4 + 0.1 sin t)
+    struct Paraboloid;
+    impl Surface for Paraboloid {
+        fn v_domain(&self) -> VDomain {
+            VDomain::open(0.0, 1.0)
+        }
+        fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+            let mut out = Vec::new();
+            for i in 0..=du {
+                for j in 0..=dv {
+                    let x = match i {
+                        0 => u,
+                        1 => 1.0,
+                        _ => 0.0,
+                    };
+                    let y = match j {
+                        0 => v,
+                        1 => 1.0,
+                        _ => 0.0,
+                    };
+                    let a = match i {
+                        0 => u * u,
+                        1 => 2.0 * u,
+                        2 => 2.0,
+                        _ => 0.0,
+                    };
+                    let b = match j {
+                        0 => v,
+                        1 => 1.0,
+                        _ => 0.0,
+                    };
+                    out.push(Vec3::new(if j == 0 { x } else { 0.0 }, if i == 0 { y } else { 0.0 }, a * b));
+                }
+            }
+            out
+        }
+    }
+    let g =
+        CurveOnSurface { surface: std::sync::Arc::new(Paraboloid), curve: TrimCurve::ellipse([0.5, 0.4], [0.2, 0.1]) };
+    let t: f64 = 0.7;
+    let j = g.jet(&[t, 0.0], JetShape::new(&[2]));
+    let (u, v) = (0.5 + 0.2 * t.cos(), 0.4 + 0.1 * t.sin());
+    let (du, dv) = (-0.2 * t.sin(), 0.1 * t.cos());
+    let (ddu, ddv) = (-0.2 * t.cos(), -0.1 * t.sin());
+    // z = u² v: z' = 2u u' v + u² v', z'' = 2u'² v + 2u u'' v + 4u u' v' + u² v''
+    let z1 = 2.0 * u * du * v + u * u * dv;
+    let z2 = 2.0 * du * du * v + 2.0 * u * ddu * v + 4.0 * u * du * dv + u * u * ddv;
+    assert!((j.value().z - u * u * v).abs() < 1e-15);
+    assert!((j.derivative([1, 0, 0]).z - z1).abs() < 1e-14);
+    assert!((j.derivative([2, 0, 0]).z - z2).abs() < 1e-13);
+    assert!((j.derivative([2, 0, 0]).x - ddu).abs() < 1e-14);
+}
+
+/// A closed B-spline whose control points lie at radius `r(θ)` about `c`.
+fn star(c: Uv, radii: &[f64]) -> TrimCurve {
+    let n = radii.len();
+    let pts: Vec<Uv> = radii
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let th = TAU * k as f64 / n as f64;
+            [c[0] + r * th.cos(), c[1] + r * th.sin()]
+        })
+        .collect();
+    TrimCurve::bspline(&pts).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Random star-shaped spline trims: valid grids, usually without any repair.
+    #[test]
+    fn random_star_shaped_trims(
+        cx in 0.35..0.65f64, cy in 0.35..0.65f64,
+        radii in proptest::collection::vec(0.08..0.25f64, 5..12),
+        rings in 6usize..24, columns in 16usize..96,
+    ) {
+        let r = region(vec![("s", star([cx, cy], &radii))]);
+        let map = LaplaceMap::new(r.clone(), 12, Some(columns));
+        let g = trim_grid(&map, &opts(rings, columns)).unwrap();
+        assert_valid(&r, &g);
+    }
+
+    /// Random non-convex trims: alternating dents (inner/outer radius 0.4 … 0.7) as
+    /// splines and as polygons, around a random centre.
+    #[test]
+    fn random_nonconvex_trims(
+        cx in 0.4..0.6f64, cy in 0.4..0.6f64,
+        outer in 0.2..0.3f64, ratio in 0.4..0.7f64, lobes in 3usize..6,
+        jitter in proptest::collection::vec(0.85..1.0f64, 12),
+        polygon in any::<bool>(),
+    ) {
+        let r = region(vec![("n", dented([cx, cy], outer, ratio, lobes, &jitter, polygon))]);
+        let map = LaplaceMap::new(r.clone(), 16, Some(96));
+        let g = trim_grid(&map, &opts(24, 96)).unwrap();
+        assert_valid(&r, &g);
+    }
+
+    /// Deep spikes (ratio 0.15 … 0.4) can defeat the repair of a structured grid (a spike
+    /// tip needs more than one grid line): then the result is an error, never a folded mesh.
+    #[test]
+    fn deep_spikes_give_a_valid_mesh_or_an_error(
+        outer in 0.2..0.3f64, ratio in 0.15..0.4f64, lobes in 3usize..7,
+        jitter in proptest::collection::vec(0.85..1.0f64, 12),
+        polygon in any::<bool>(),
+    ) {
+        let r = region(vec![("n", dented([0.5, 0.5], outer, ratio, lobes, &jitter, polygon))]);
+        let map = LaplaceMap::new(r.clone(), 16, Some(96));
+        match trim_grid(&map, &TrimOptions { max_sweeps: 400, ..opts(24, 96) }) {
+            Ok(g) => assert_valid(&r, &g),
+            Err(e) => prop_assert!(matches!(e, TrimError::CannotRepair { .. }), "{}", e),
+        }
+    }
+}
+
+/// A star with `lobes` outer points at radius `outer` and dents at `outer·ratio`.
+fn dented(c: Uv, outer: f64, ratio: f64, lobes: usize, jitter: &[f64], polygon: bool) -> TrimCurve {
+    let n = 2 * lobes;
+    let radii: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { outer } else { outer * ratio } * jitter[k % 12]).collect();
+    if polygon {
+        let pts: Vec<Uv> = radii
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let th = TAU * k as f64 / n as f64;
+                [c[0] + r * th.cos(), c[1] + r * th.sin()]
+            })
+            .collect();
+        TrimCurve::polygon(&pts).unwrap()
+    } else {
+        star(c, &radii)
+    }
+}
