@@ -22,12 +22,16 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
         return Ok(m);
     }
     let (nu, nv) = p.resolution;
-    let mut m =
-        grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
+    let mut m = match &p.trim {
+        // a trimmed patch: the (ρ, φ) grid of its region; the trim loop is its highlighted curve
+        Some(t) => pdeshape_core::trim::trimmed_mesh(p.surface.as_ref(), &t.grid),
+        None => grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)),
+    }
+    .map_err(|e| format!("patch `{}`: {e}", p.name))?;
     m.name = p.name.clone();
     let dom = p.surface.v_domain();
     let n = (4 * nv).max(64);
-    for c in p.conditions.iter().filter(|c| c.order == 0) {
+    for c in p.conditions.iter().filter(|c| c.order == 0 && p.trim.is_none()) {
         let pts: Vec<_> = (0..=n).map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64))).collect();
         m.curves.push(pts);
     }
@@ -383,6 +387,92 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
     })
 }
 
+/// The trim section of `check`: fold counts before and after repair, cell angles, the
+/// area ratio, and how far the mesh boundary lies from the trim loop (parameter space).
+fn trim_diagnostics(t: &crate::scene::TrimSetup) -> Value {
+    let g = &t.grid;
+    let r = &g.report;
+    let region = t.map.region();
+    let boundary = (0..g.columns).map(|j| region.loop_distance(g.points[j])).fold(0.0, f64::max);
+    json!({
+        "curves": region.curves.iter().map(|c| c.0.clone()).collect::<Vec<_>>(),
+        "bridges": region.bridges.len(),
+        "rings": r.rings,
+        "columns": r.columns,
+        "modes": r.modes,
+        "omega": r.omega,
+        "folds_before": r.folds_before,
+        "folds_after": r.folds_after,
+        "inside_before": r.inside_before,
+        "inside_after": r.inside_after,
+        "repair_sweeps": r.sweeps,
+        "min_angle_deg": r.min_angle,
+        "max_angle_deg": r.max_angle,
+        "area_ratio": r.area_ratio,
+        "cell_area_ratio": r.cell_area_ratio,
+        "boundary_error": boundary,
+    })
+}
+
+/// The trim of a patch in its parameter domain: the `(ρ, φ)` grid, the trim curves, the
+/// bridges and the domain border (paper 003, Figs. 3, 5a–7a).
+pub fn trim_picture(p: &ScenePatch) -> Option<Result<Image, String>> {
+    use crate::render::{Layer, polyline_plot};
+    use pdeshape_core::trim::Piece;
+    let t = p.trim.as_ref()?;
+    let g = &t.grid;
+    let region = t.map.region();
+    let pt = |q: [f64; 2]| (q[0], q[1]);
+    let rings: Vec<Vec<(f64, f64)>> =
+        (0..g.rings).map(|i| (0..=g.columns).map(|j| pt(g.points[g.index(i, j)])).collect()).collect();
+    let cols: Vec<Vec<(f64, f64)>> =
+        (0..g.columns).map(|j| (0..g.rings).map(|i| pt(g.points[g.index(i, j)])).collect()).collect();
+    let curves: Vec<Vec<(f64, f64)>> = region
+        .curves
+        .iter()
+        .map(|(_, c)| {
+            let mut l: Vec<_> = c.polygonize(64).into_iter().map(|x| pt(x.1)).collect();
+            l.push(l[0]);
+            l
+        })
+        .collect();
+    let bridges: Vec<Vec<(f64, f64)>> = region
+        .pieces
+        .iter()
+        .filter_map(|q| match q {
+            Piece::Segment { a, b } => Some(vec![pt(*a), pt(*b)]),
+            _ => None,
+        })
+        .collect();
+    let d = region.domain;
+    let border = vec![vec![
+        (d.min[0], d.min[1]),
+        (d.max[0], d.min[1]),
+        (d.max[0], d.max[1]),
+        (d.min[0], d.max[1]),
+        (d.min[0], d.min[1]),
+    ]];
+    let layers = [
+        Layer { lines: cols, rgb: [225, 150, 150], width: 1, label: String::new() },
+        Layer { lines: rings, rgb: [150, 170, 230], width: 1, label: String::new() },
+        Layer { lines: border, rgb: [40, 40, 40], width: 2, label: "border C₂".into() },
+        Layer { lines: curves, rgb: [0, 0, 0], width: 2, label: "trim curves".into() },
+        Layer { lines: bridges, rgb: [220, 120, 0], width: 3, label: "bridges".into() },
+    ];
+    let pad = 0.03 * (d.max[0] - d.min[0]).max(d.max[1] - d.min[1]);
+    let title = format!(
+        "{}: trim in (u, v), {} × {} grid, {} folds repaired",
+        p.name, g.rings, g.columns, g.report.folds_before
+    );
+    Some(polyline_plot(
+        &title,
+        ("u", "v"),
+        ((d.min[0] - pad, d.max[0] + pad), (d.min[1] - pad, d.max[1] + pad)),
+        &layers,
+        (600, 600),
+    ))
+}
+
 /// Diagnostics of one patch, as `check --json` prints them.
 pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     if let Some(sd) = &p.solid {
@@ -450,6 +540,9 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         },
         "warnings": [],
     });
+    if let Some(t) = &p.trim {
+        d["trim"] = trim_diagnostics(t);
+    }
     if let Some(fam) = &p.sections {
         // How far the patch strays from the section family between its sections.
         let distance = |s_of: &dyn Fn(f64) -> f64| {

@@ -88,9 +88,12 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         }
     }
     for p in &scene.patches {
-        for (suffix, pic) in
-            [("sections", model::solid_sections_picture(&scene, p)), ("convergence", model::solid_convergence_plot(p))]
-        {
+        for (suffix, pic) in [
+            ("trim", model::trim_picture(p)),
+            ("sections", model::solid_sections_picture(&scene, p)),
+            ("convergence", model::solid_convergence_plot(p)),
+            ("convergence", model::convergence_plot(p)),
+        ] {
             match pic {
                 Some(Ok(img)) => {
                     let rel = format!("{name}/{name}-{}-{suffix}.png", p.name);
@@ -100,18 +103,6 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
                 }
                 Some(Err(err)) => e.error = Some(err),
                 None => {}
-            }
-        }
-        if let Some(plot) = model::convergence_plot(p) {
-            match plot {
-                Ok(img) => {
-                    let rel = format!("{name}/{name}-{}-convergence.png", p.name);
-                    let path = dir.join(&rel);
-                    if pdeshape_io::export::write_atomic(&path, |w| img.write_png(w)).is_ok() {
-                        e.plots.push(rel);
-                    }
-                }
-                Err(err) => e.error = Some(err),
             }
         }
     }

@@ -146,7 +146,21 @@ impl TrimRegion {
     /// Joins the curves by a minimum spanning tree of shortest bridges and builds the loop.
     fn join(&mut self) -> Result<(), TrimError> {
         let n = self.curves.len();
-        let samples: Vec<Vec<(f64, Uv)>> = self.curves.iter().map(|(_, c)| c.polygonize(SAMPLES_PER_KNOT)).collect();
+        // Bridge ends avoid polygon vertices: a bridge from a corner leaves a re-entrant
+        // corner that a single grid line cannot split into two convex cells.
+        let samples: Vec<Vec<(f64, Uv)>> = self
+            .curves
+            .iter()
+            .map(|(_, c)| {
+                let pts = c.polygonize(SAMPLES_PER_KNOT);
+                match c {
+                    TrimCurve::Spline(b) if b.degree() == 1 => {
+                        pts.into_iter().enumerate().filter(|(k, _)| k % SAMPLES_PER_KNOT != 0).map(|x| x.1).collect()
+                    }
+                    _ => pts,
+                }
+            })
+            .collect();
         // closest sample pair between every two curves
         let mut best = vec![vec![(f64::INFINITY, 0.0, 0.0); n]; n];
         for i in 0..n {
@@ -297,6 +311,18 @@ impl TrimRegion {
             }
         }
         out
+    }
+
+    /// Distance from `p` to the loop: exact on the curves ([`TrimCurve::closest`]), and to
+    /// the bridge segments.
+    pub fn loop_distance(&self, p: Uv) -> f64 {
+        let mut d = self.curves.iter().map(|(_, c)| c.closest(p).1).fold(f64::INFINITY, f64::min);
+        for piece in &self.pieces {
+            if let Piece::Segment { a, b } = piece {
+                d = d.min(distance_to_segment(p, *a, *b));
+            }
+        }
+        d
     }
 
     /// True when `p` lies inside (or within `tol` of) some trim curve, judged on the fine

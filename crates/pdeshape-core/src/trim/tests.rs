@@ -8,17 +8,6 @@ fn region(curves: Vec<(&str, TrimCurve)>) -> TrimRegion {
     TrimRegion::new(UNIT, curves.into_iter().map(|(n, c)| (n.to_string(), c)).collect()).unwrap()
 }
 
-/// Distance from `p` to the trim loop (curves exactly, bridges as segments).
-fn loop_distance(r: &TrimRegion, p: Uv) -> f64 {
-    let mut d = r.curves.iter().map(|(_, c)| c.closest(p).1).fold(f64::INFINITY, f64::min);
-    for piece in &r.pieces {
-        if let Piece::Segment { a, b } = piece {
-            d = d.min(super::curve::distance_to_segment(p, *a, *b));
-        }
-    }
-    d
-}
-
 fn on_border(p: Uv) -> bool {
     p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0
 }
@@ -30,7 +19,7 @@ fn assert_valid(r: &TrimRegion, g: &TrimGrid) {
     assert_eq!(count_folds(&g.points, g.rings, g.columns), 0);
     for j in 0..g.columns {
         let p = g.points[j];
-        assert!(loop_distance(r, p) < 1e-10, "ring 0, column {j}: {p:?} is {} off", loop_distance(r, p));
+        assert!(r.loop_distance(p) < 1e-10, "ring 0, column {j}: {p:?} is {} off", r.loop_distance(p));
         assert!(on_border(g.points[(g.rings - 1) * g.columns + j]));
     }
     let fine: Vec<Vec<Uv>> =

@@ -7,7 +7,7 @@ mod raster;
 mod text;
 
 pub use image::Image;
-pub use plot::{Series, line_plot};
+pub use plot::{Layer, Series, line_plot, polyline_plot};
 pub use raster::{Camera, RenderItem, render};
 pub use text::draw_text;
 

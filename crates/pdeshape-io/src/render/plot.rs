@@ -99,9 +99,85 @@ pub fn line_plot(
             .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
+    Ok(to_image(&buf, w, h))
+}
+
+/// A layer of polylines for [`polyline_plot`]: lines, colour, stroke width.
+pub struct Layer {
+    /// Polylines.
+    pub lines: Vec<Vec<(f64, f64)>>,
+    /// Colour.
+    pub rgb: [u8; 3],
+    /// Stroke width in pixels.
+    pub width: u32,
+    /// Legend label (none when empty).
+    pub label: String,
+}
+
+/// Polylines in a fixed rectangle `x0..x1 × y0..y1`, drawn in layer order (a parameter
+/// space picture).
+pub fn polyline_plot(
+    title: &str,
+    labels: (&str, &str),
+    range: ((f64, f64), (f64, f64)),
+    layers: &[Layer],
+    size: (u32, u32),
+) -> Result<Image, String> {
+    register_font();
+    let (w, h) = size;
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let ((x0, x1), (y0, y1)) = range;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(48)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(labels.0)
+            .y_desc(labels.1)
+            .label_style(("sans-serif", 15))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut legend = false;
+        for l in layers {
+            let col = RGBColor(l.rgb[0], l.rgb[1], l.rgb[2]);
+            let style = col.stroke_width(l.width);
+            let mut first = true;
+            for line in &l.lines {
+                let a = chart.draw_series(LineSeries::new(line.iter().copied(), style)).map_err(|e| e.to_string())?;
+                if first && !l.label.is_empty() {
+                    a.label(l.label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                    legend = true;
+                }
+                first = false;
+            }
+        }
+        if legend {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 14))
+                .draw()
+                .map_err(|e| e.to_string())?;
+        }
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(to_image(&buf, w, h))
+}
+
+/// An RGB buffer as an image.
+fn to_image(buf: &[u8], w: u32, h: u32) -> Image {
     let mut img = Image::new(w, h, [255, 255, 255]);
     for (i, px) in buf.chunks(3).enumerate() {
         img.data[4 * i..4 * i + 3].copy_from_slice(px);
     }
-    Ok(img)
+    img
 }

@@ -27,9 +27,9 @@ pub const MAX_VERTICES: usize = 4_000_000;
 /// Output formats a scene may list.
 pub const FORMATS: &[&str] = &["obj", "ply", "stl", "glb", "vtu", "png"];
 
-type R<T> = Result<T, SceneError>;
+pub(super) type R<T> = Result<T, SceneError>;
 
-struct Ctx<'a> {
+pub(super) struct Ctx<'a> {
     src: Source<'a>,
     params: IndexMap<String, Param>,
     /// Solver override for patches that offer a choice.
@@ -38,7 +38,7 @@ struct Ctx<'a> {
     terms: Option<usize>,
 }
 
-fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
+pub(super) fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
     Some(s.span())
 }
 
@@ -76,7 +76,7 @@ impl Ctx<'_> {
         }
     }
 
-    fn err(&self, span: Option<Range<usize>>, key: impl Into<String>, msg: impl Into<String>) -> SceneError {
+    pub(super) fn err(&self, span: Option<Range<usize>>, key: impl Into<String>, msg: impl Into<String>) -> SceneError {
         self.src.error(span, key, msg)
     }
 
@@ -113,7 +113,7 @@ impl Ctx<'_> {
     }
 
     /// A constant: a number or an expression in the parameters.
-    fn num(&self, x: &NumOrExpr, sp: Option<Range<usize>>, key: &str) -> R<f64> {
+    pub(super) fn num(&self, x: &NumOrExpr, sp: Option<Range<usize>>, key: &str) -> R<f64> {
         let v = match x {
             NumOrExpr::Num(v) => *v,
             NumOrExpr::Expr(s) => {
@@ -138,7 +138,7 @@ impl Ctx<'_> {
             .map_err(|(i, e)| self.expr_err(span(x), format!("{key}[{i}]"), &texts[i], &e))
     }
 
-    fn int(&self, x: &Spanned<i64>, lo: i64, hi: i64, key: &str) -> R<i64> {
+    pub(super) fn int(&self, x: &Spanned<i64>, lo: i64, hi: i64, key: &str) -> R<i64> {
         let v = *x.get_ref();
         if v < lo || v > hi {
             return Err(self.err(span(x), key, format!("{v} is out of range (expected {lo} … {hi})")));
@@ -175,7 +175,12 @@ impl Ctx<'_> {
         }
     }
 
-    fn resolution(&self, x: &Option<Spanned<[i64; 2]>>, default: (usize, usize), key: &str) -> R<(usize, usize)> {
+    pub(super) fn resolution(
+        &self,
+        x: &Option<Spanned<[i64; 2]>>,
+        default: (usize, usize),
+        key: &str,
+    ) -> R<(usize, usize)> {
         let Some(x) = x else { return Ok(default) };
         let [a, b] = *x.get_ref();
         if a < 2 || b < 2 {
@@ -611,7 +616,8 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
 
     let mut patches = Vec::new();
     for (pname, p) in &raw.patches {
-        patches.push(build_patch(&ctx, pname, p, &curves, &surfaces)?);
+        let built = build_patch(&ctx, pname, p, &curves, &surfaces, &patches)?;
+        patches.push(built);
     }
 
     let r = &raw.render;
@@ -702,6 +708,7 @@ fn build_patch(
     p: &Spanned<RawPatch>,
     curves: &IndexMap<String, FieldRef>,
     surfaces: &[SceneSurface],
+    done: &[ScenePatch],
 ) -> R<ScenePatch> {
     let key = format!("patches.{pname}");
     let rp = p.get_ref();
@@ -772,6 +779,13 @@ fn build_patch(
     ] {
         only(present, name, PatchKind::Solid)?;
     }
+    if rp.trim.is_some() && matches!(kind, PatchKind::Dynamic | PatchKind::Solid) {
+        return Err(ctx.err(
+            span(p),
+            format!("{key}.trim"),
+            "trims apply to hermite, pde and blend patches (not to moving or solid ones)",
+        ));
+    }
     if kind == PatchKind::Solid {
         for (present, name) in [(rp.conditions.is_some(), "conditions"), (rp.resolution.is_some(), "resolution")] {
             if present {
@@ -841,12 +855,12 @@ fn build_patch(
             Some(o) => ctx.int(o, 0, 12, &format!("{ck}.order"))? as usize,
             None => 0,
         };
-        let n_src = [c.curve.is_some(), c.expr.is_some(), c.point.is_some(), c.surface.is_some()]
+        let n_src = [c.curve.is_some(), c.expr.is_some(), c.point.is_some(), c.surface.is_some(), c.trim.is_some()]
             .iter()
             .filter(|b| **b)
             .count();
         if n_src != 1 {
-            return Err(ctx.err(span(rc), &ck, "a condition needs exactly one of: curve, expr, point, surface"));
+            return Err(ctx.err(span(rc), &ck, "a condition needs exactly one of: curve, expr, point, surface, trim"));
         }
         if c.surface.is_none() && (c.s.is_some() || c.scale.is_some()) {
             return Err(ctx.err(span(rc), &ck, "`s` and `scale` only apply to trimline conditions (with `surface`)"));
@@ -867,6 +881,8 @@ fn build_patch(
                     ),
                 )
             })?
+        } else if let Some(t) = &c.trim {
+            super::trim::trim_condition(ctx, t, &format!("{ck}.trim"), done)?
         } else if let Some(x) = &c.expr {
             Arc::new(ctx.field(x, &["v", "t"], &format!("{ck}.expr"))?)
         } else if let Some(x) = &c.point {
@@ -939,6 +955,7 @@ fn build_patch(
         PatchKind::Solid => unreachable!("solid patches are built by build_solid"),
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
+    let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, domain)).transpose()?;
     Ok(ScenePatch {
         name: pname.to_string(),
         kind,
@@ -951,6 +968,7 @@ fn build_patch(
         blend,
         dynamic,
         solid: None,
+        trim,
     })
 }
 
@@ -1046,6 +1064,7 @@ fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<Sc
         blend: None,
         dynamic: None,
         solid: Some(super::SolidSetup { blend, faces, cells, primary }),
+        trim: None,
     })
 }
 

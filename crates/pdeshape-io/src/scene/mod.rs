@@ -11,9 +11,11 @@
 mod build;
 mod error;
 mod raw;
+mod trim;
 
 pub use build::{MAX_VERTICES, RESERVED};
 pub use error::{SceneError, Source};
+pub use trim::MAX_TRIM_VERTICES;
 
 use indexmap::IndexMap;
 use pdeshape_core::data::FieldRef;
@@ -120,6 +122,17 @@ pub struct ScenePatch {
     pub dynamic: Option<DynamicSetup>,
     /// The solid blend, for solid patches (`surface` is then its mid cross section w = ½).
     pub solid: Option<SolidSetup>,
+    /// The trim and its meshed region, for trimmed patches.
+    pub trim: Option<TrimSetup>,
+}
+
+/// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid.
+#[derive(Clone, Debug)]
+pub struct TrimSetup {
+    /// The map (holds the validated region).
+    pub map: Arc<pdeshape_core::trim::LaplaceMap>,
+    /// The grid in the parameter domain, with its quality report.
+    pub grid: Arc<pdeshape_core::trim::TrimGrid>,
 }
 
 /// A solid blend with its mesh settings.

@@ -115,6 +115,8 @@ pub struct RawCondition {
     pub surface: Option<Spanned<String>>,
     pub s: Option<Spanned<NumOrExpr>>,
     pub scale: Option<Spanned<NumOrExpr>>,
+    /// A trim curve of an earlier patch carried onto that patch: `"PATCH.CURVE"`.
+    pub trim: Option<Spanned<String>>,
 }
 
 /// `[patches.NAME]`.
@@ -180,6 +182,8 @@ pub struct RawPatch {
     pub time: Option<Spanned<[NumOrExpr; 2]>>,
     /// Dynamic blends: the number of animation frames (≥ 2).
     pub frames: Option<Spanned<i64>>,
+    /// Trims: closed curves in `(u, v)` whose insides are removed.
+    pub trim: Option<Spanned<RawTrim>>,
     /// Blends: the primary surface at `u = 0` (conditions of orders 0, 1, 2 from its trimline).
     pub start: Option<Spanned<RawEnd>>,
     /// Blends: the primary surface at `u = 1`.
@@ -272,4 +276,37 @@ pub struct RawStudy {
     /// The parameter that varies.
     pub vary: String,
     pub values: Vec<f64>,
+}
+
+/// `[patches.NAME.trim]`: trim curves and the trimmed mesh.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTrim {
+    /// `[rings, columns]` of the `(ρ, φ)` grid.
+    pub resolution: Option<Spanned<[i64; 2]>>,
+    /// Fourier modes of the Laplace map.
+    pub modes: Option<Spanned<i64>>,
+    /// The curves by name.
+    pub curves: IndexMap<String, Spanned<RawTrimCurve>>,
+}
+
+/// One trim curve: exactly one of the keys.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTrimCurve {
+    /// `{ center = [u, v], radius = r }` or `{ center, radii = [r_u, r_v] }`.
+    pub circle: Option<Spanned<RawCircle>>,
+    /// Closed cubic B-spline control points `[u, v]`.
+    pub bspline: Option<Spanned<Vec<[NumOrExpr; 2]>>>,
+    /// Polygon vertices `[u, v]`.
+    pub polygon: Option<Spanned<Vec<[NumOrExpr; 2]>>>,
+}
+
+/// A circle or axis-aligned ellipse in `(u, v)`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCircle {
+    pub center: [NumOrExpr; 2],
+    pub radius: Option<NumOrExpr>,
+    pub radii: Option<[NumOrExpr; 2]>,
 }
