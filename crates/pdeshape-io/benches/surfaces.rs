@@ -8,6 +8,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_core::solid::{SolidBlend, SolidOptions, Trial};
+use pdeshape_core::trim::{LaplaceMap, TrimOptions, trim_grid};
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
 
@@ -79,6 +80,18 @@ fn surfaces(c: &mut Criterion) {
     });
     let lin: Vec<f64> = (0..64).map(|i| i as f64 / 63.0).collect();
     g.bench_function("evaluate 64^3", |b| b.iter(|| sd.blend.grid(&lin, &lin, &lin)));
+    g.finish();
+
+    // SPEC §10: trimmed 140 × 170 Laplace mesh ≤ 0.5 ms and faster than spade's CDT (the
+    // comparison with spade is `pdeshape bench`, paper 003 Table 1).
+    let trim = load("trim-circle.toml");
+    let t = trim.patches[0].trim.as_ref().expect("a trimmed patch");
+    let region = t.map.region().clone();
+    let o = TrimOptions { rings: 140, columns: 170, modes: t.map.modes(), verify: false, ..Default::default() };
+    let mut g = c.benchmark_group("trim (paper 003 Fig. 3)");
+    g.bench_function("Laplace map + 140x170 grid + fold check", |b| {
+        b.iter(|| trim_grid(&LaplaceMap::new(region.clone(), o.modes, Some(170)), &o).unwrap())
+    });
     g.finish();
 }
 

@@ -393,10 +393,14 @@ fn trim_diagnostics(t: &crate::scene::TrimSetup) -> Value {
     let g = &t.grid;
     let r = &g.report;
     let region = t.map.region();
-    let boundary = (0..g.columns).map(|j| region.loop_distance(g.points[j])).fold(0.0, f64::max);
+    let k = t.scale;
+    let boundary = (0..g.columns)
+        .map(|j| region.loop_distance([g.points[j][0] * k[0], g.points[j][1] * k[1]]))
+        .fold(0.0, f64::max);
     json!({
         "curves": region.curves.iter().map(|c| c.0.clone()).collect::<Vec<_>>(),
         "bridges": region.bridges.len(),
+        "metric_scale": k,
         "rings": r.rings,
         "columns": r.columns,
         "modes": r.modes,
@@ -422,11 +426,13 @@ pub fn trim_picture(p: &ScenePatch) -> Option<Result<Image, String>> {
     let t = p.trim.as_ref()?;
     let g = &t.grid;
     let region = t.map.region();
-    let pt = |q: [f64; 2]| (q[0], q[1]);
+    let k = t.scale;
+    let pt = |q: [f64; 2]| (q[0] / k[0], q[1] / k[1]);
+    let grid_pt = |q: [f64; 2]| (q[0], q[1]);
     let rings: Vec<Vec<(f64, f64)>> =
-        (0..g.rings).map(|i| (0..=g.columns).map(|j| pt(g.points[g.index(i, j)])).collect()).collect();
+        (0..g.rings).map(|i| (0..=g.columns).map(|j| grid_pt(g.points[g.index(i, j)])).collect()).collect();
     let cols: Vec<Vec<(f64, f64)>> =
-        (0..g.columns).map(|j| (0..g.rings).map(|i| pt(g.points[g.index(i, j)])).collect()).collect();
+        (0..g.columns).map(|j| (0..g.rings).map(|i| grid_pt(g.points[g.index(i, j)])).collect()).collect();
     let curves: Vec<Vec<(f64, f64)>> = region
         .curves
         .iter()
@@ -444,7 +450,10 @@ pub fn trim_picture(p: &ScenePatch) -> Option<Result<Image, String>> {
             _ => None,
         })
         .collect();
-    let d = region.domain;
+    let d = pdeshape_core::trim::Rect {
+        min: [region.domain.min[0] / k[0], region.domain.min[1] / k[1]],
+        max: [region.domain.max[0] / k[0], region.domain.max[1] / k[1]],
+    };
     let border = vec![vec![
         (d.min[0], d.min[1]),
         (d.max[0], d.min[1]),

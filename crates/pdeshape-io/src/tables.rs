@@ -159,3 +159,98 @@ pub fn on_one_thread<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, String>
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| e.to_string())?;
     Ok(pool.install(f))
 }
+
+/// One row of paper 003's Table 1: meshing the region outside the Fig. 3 trim.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrimTableRow {
+    /// `(rings, columns)`: the paper's "mesh (u, v)".
+    pub mesh: (usize, usize),
+    /// Vertices of both meshes.
+    pub vertices: usize,
+    /// The paper's Laplace time (ms).
+    pub paper_laplace_ms: f64,
+    /// The paper's Delaunay time (ms).
+    pub paper_delaunay_ms: f64,
+    /// Ours: Laplace map solve + grid + fold check, in the parameter domain.
+    pub laplace: Timing,
+    /// `spade`'s constrained Delaunay triangulation of the same vertices, with the trim
+    /// loop and the border as constraint edges.
+    pub delaunay: Timing,
+    /// Triangles of the Delaunay mesh that lie inside the trim (they must be removed after
+    /// the triangulation; counted, not timed).
+    pub delaunay_inside: usize,
+}
+
+/// Paper 003 Table 1 on the trim of `scene`'s first trimmed patch (the Fig. 3 circle):
+/// for each resolution, the Laplace meshing and a constrained Delaunay triangulation of the
+/// same points, medians of `runs` runs.
+pub fn trim_table1(scene: &Scene, runs: usize) -> Result<Vec<TrimTableRow>, String> {
+    use pdeshape_core::trim::{LaplaceMap, TrimOptions, trim_grid};
+    use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+    let t = scene
+        .patches
+        .iter()
+        .find_map(|p| p.trim.as_ref())
+        .ok_or_else(|| format!("scene `{}` has no trimmed patch", scene.name))?;
+    let region = t.map.region().clone();
+    let modes = t.map.modes();
+    let mut rows = Vec::new();
+    for ((rings, columns), paper_l, paper_d) in [
+        ((10, 20), 0.0313333, 0.1391),
+        ((20, 30), 0.1561, 0.3333),
+        ((40, 70), 0.3912, 0.89),
+        ((140, 170), 4.2265, 7.10128),
+    ] {
+        let o = TrimOptions { rings, columns, modes, verify: false, ..Default::default() };
+        let mut err = None;
+        let laplace = time(runs, || {
+            let map = LaplaceMap::new(region.clone(), modes, Some(columns));
+            if let Err(e) = trim_grid(&map, &o) {
+                err = Some(e.to_string());
+            }
+        });
+        if let Some(e) = err {
+            return Err(e);
+        }
+        let grid = trim_grid(&LaplaceMap::new(region.clone(), modes, Some(columns)), &o).map_err(|e| e.to_string())?;
+        let pts: Vec<Point2<f64>> = grid.points.iter().map(|p| Point2::new(p[0], p[1])).collect();
+        // constraint edges: ring 0 (the trim loop) and the last ring (the border)
+        let mut edges = Vec::new();
+        for ring in [0, rings - 1] {
+            for j in 0..columns {
+                edges.push([grid.index(ring, j), grid.index(ring, j + 1)]);
+            }
+        }
+        let mut cdt_err = None;
+        let delaunay = time(runs, || {
+            match ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(pts.clone(), edges.clone()) {
+                Ok(c) => {
+                    std::hint::black_box(c.num_inner_faces());
+                }
+                Err(e) => cdt_err = Some(format!("{e:?}")),
+            }
+        });
+        if let Some(e) = cdt_err {
+            return Err(format!("spade: {e}"));
+        }
+        let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(pts.clone(), edges.clone())
+            .map_err(|e| format!("spade: {e:?}"))?;
+        let delaunay_inside = cdt
+            .inner_faces()
+            .filter(|f| {
+                let c = f.center();
+                region.in_hole([c.x, c.y], 0.0)
+            })
+            .count();
+        rows.push(TrimTableRow {
+            mesh: (rings, columns),
+            vertices: pts.len(),
+            paper_laplace_ms: paper_l,
+            paper_delaunay_ms: paper_d,
+            laplace,
+            delaunay,
+            delaunay_inside,
+        });
+    }
+    Ok(rows)
+}

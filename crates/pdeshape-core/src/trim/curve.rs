@@ -54,6 +54,23 @@ impl TrimCurve {
         Ok(TrimCurve::Spline(BSplineCurve::new(pts, degree, true, (0.0, TAU))?))
     }
 
+    /// The curve with `u` and `v` multiplied by `k[0]` and `k[1]` (an affine image: the
+    /// ellipse's centre and radii, the spline's control points).
+    pub fn scaled(&self, k: Uv) -> Self {
+        match self {
+            TrimCurve::Ellipse { center, radii } => TrimCurve::Ellipse {
+                center: [center[0] * k[0], center[1] * k[1]],
+                radii: [radii[0] * k[0], radii[1] * k[1]],
+            },
+            TrimCurve::Spline(b) => {
+                let pts = b.points().iter().map(|p| Vec3::new(p.x * k[0], p.y * k[1], 0.0)).collect();
+                TrimCurve::Spline(
+                    BSplineCurve::new(pts, b.degree(), true, b.range()).expect("scaling keeps a valid spline valid"),
+                )
+            }
+        }
+    }
+
     /// `C⁽ᵏ⁾(t)` for `k = 0 … nd` (exact).
     pub fn derivatives(&self, t: f64, nd: usize) -> Vec<Uv> {
         match self {

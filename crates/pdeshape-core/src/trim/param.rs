@@ -2,7 +2,8 @@
 //! `φ ∈ [0, 2π)` with corresponding starting points (SPEC §7).
 //!
 //! - The inner loop `C₁` (trim curves and bridges) is parameterised by the measure
-//!   `dμ = |dθ| + w·2π ds/L` (`w` = [`ARC_WEIGHT`], or [`ARC_WEIGHT_BRIDGED`] for several curves), where `θ` is the polar angle about the trim centre `c`, `s`
+//!   `dμ = |dθ| + w·2π ds/L` (`w` = [`ARC_WEIGHT`], or [`ARC_WEIGHT_BRIDGED`] for several curves, which also add
+//!   [`TURN_WEIGHT_BRIDGED`] times the turning of the tangent), where `θ` is the polar angle about the trim centre `c`, `s`
 //!   arc length and `L` the loop length, normalised to `2π`. For a trim that is
 //!   star-shaped about `c` this is close to the polar angle, so the rays `φ = const` of the
 //!   map run nearly radially; the arc-length part keeps radial stretches of non-star-shaped
@@ -18,6 +19,10 @@ use std::f64::consts::TAU;
 
 /// Weight `w` of arc length in the inner parameterisation of a single trim curve.
 pub const ARC_WEIGHT: f64 = 0.15;
+
+/// Weight of the tangent's turning angle in the inner parameterisation of loops joined by
+/// bridges: puts columns where small curves bend sharply (the tips of slender holes).
+pub const TURN_WEIGHT_BRIDGED: f64 = 1.0;
 
 /// The same for loops joined by bridges: mostly arc length, so that each curve and each
 /// bridge gets columns in proportion to its length.
@@ -50,6 +55,8 @@ impl InnerParam {
         let w = if region.bridges.is_empty() { ARC_WEIGHT } else { ARC_WEIGHT_BRIDGED };
         let mut mu = 0.0;
         let mut table = Vec::with_capacity(n + 1);
+        let turn_w = if region.bridges.is_empty() { 0.0 } else { TURN_WEIGHT_BRIDGED };
+        let dir = |a: Uv, b: Uv| (b[1] - a[1]).atan2(b[0] - a[0]);
         for k in 0..=n {
             let (piece, s, p) = if k < n { samples[k] } else { (usize::MAX, 0.0, samples[0].2) };
             if k > 0 {
@@ -57,6 +64,12 @@ impl InnerParam {
                 let mut d = angle(p) - angle(q);
                 d -= TAU * (d / TAU).round();
                 mu += d.abs() + w * TAU * (p[0] - q[0]).hypot(p[1] - q[1]) / len;
+                // turning of the tangent inside a piece (not at the kinks between pieces)
+                if turn_w > 0.0 && k >= 2 && k < n && samples[k - 2].0 == piece && samples[k - 1].0 == piece {
+                    let mut t = dir(q, p) - dir(samples[k - 2].2, q);
+                    t -= TAU * (t / TAU).round();
+                    mu += turn_w * t.abs();
+                }
             }
             table.push((mu, piece, s));
         }

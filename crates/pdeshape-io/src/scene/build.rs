@@ -955,7 +955,7 @@ fn build_patch(
         PatchKind::Solid => unreachable!("solid patches are built by build_solid"),
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, domain)).transpose()?;
+    let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, domain, surface.as_ref())).transpose()?;
     Ok(ScenePatch {
         name: pname.to_string(),
         kind,

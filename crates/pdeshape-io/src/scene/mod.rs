@@ -126,13 +126,19 @@ pub struct ScenePatch {
     pub trim: Option<TrimSetup>,
 }
 
-/// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid.
+/// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid. The map
+/// is solved in the metric-scaled plane `(u, k v)` (see `scale`).
 #[derive(Clone, Debug)]
 pub struct TrimSetup {
     /// The map (holds the validated region).
     pub map: Arc<pdeshape_core::trim::LaplaceMap>,
-    /// The grid in the parameter domain, with its quality report.
+    /// The grid in the patch's parameter domain, with its quality report (figures in the
+    /// scaled plane).
     pub grid: Arc<pdeshape_core::trim::TrimGrid>,
+    /// The trim curves in the patch's parameters.
+    pub curves: Vec<(String, pdeshape_core::trim::TrimCurve)>,
+    /// The map and the quality figures work in the plane `(u·scale[0], v·scale[1])`.
+    pub scale: [f64; 2],
 }
 
 /// A solid blend with its mesh settings.

@@ -53,7 +53,13 @@ fn curve(ctx: &Ctx, rc: &Spanned<RawTrimCurve>, key: &str) -> R<TrimCurve> {
 
 /// The trim of a patch: curves validated against the patch's domain, the Laplace map and
 /// the repaired grid.
-pub(super) fn build_trim(ctx: &Ctx, key: &str, raw: &Spanned<RawTrim>, domain: VDomain) -> R<TrimSetup> {
+pub(super) fn build_trim(
+    ctx: &Ctx,
+    key: &str,
+    raw: &Spanned<RawTrim>,
+    domain: VDomain,
+    surface: &dyn Surface,
+) -> R<TrimSetup> {
     let key = format!("{key}.trim");
     let rt = raw.get_ref();
     let (rings, columns) = ctx.resolution(&rt.resolution, (20, 64), &format!("{key}.resolution"))?;
@@ -76,11 +82,36 @@ pub(super) fn build_trim(ctx: &Ctx, key: &str, raw: &Spanned<RawTrim>, domain: V
         curves.push((name.clone(), curve(ctx, rc, &format!("{key}.curves.{name}"))?));
     }
     let rect = Rect { min: [0.0, domain.start], max: [1.0, domain.end] };
-    let region = TrimRegion::new(rect, curves).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
+    // validate in the patch's own parameters (errors quote its u, v)
+    TrimRegion::new(rect, curves.clone()).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
+    // mesh in the metric-scaled plane (u, k v), k = mean|X_v| / mean|X_u|
+    let scale = [1.0, metric_scale(surface)];
+    let scaled_rect = Rect { min: [0.0, domain.start * scale[1]], max: [1.0, domain.end * scale[1]] };
+    let scaled: Vec<_> = curves.iter().map(|(n, c)| (n.clone(), c.scaled(scale))).collect();
+    let region = TrimRegion::new(scaled_rect, scaled).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
     let map = LaplaceMap::new(region, modes, Some(columns));
-    let grid = trim_grid(&map, &TrimOptions { rings, columns, modes, ..Default::default() })
+    let mut grid = trim_grid(&map, &TrimOptions { rings, columns, modes, ..Default::default() })
         .map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-    Ok(TrimSetup { map: Arc::new(map), grid: Arc::new(grid) })
+    for p in &mut grid.points {
+        p[1] /= scale[1];
+    }
+    Ok(TrimSetup { map: Arc::new(map), grid: Arc::new(grid), curves, scale })
+}
+
+/// `mean |X_v| / mean |X_u|` over a 9 × 9 grid: the factor on `v` that makes the
+/// parameter plane roughly isometric to the patch, so the Laplace map and its repair work
+/// on the shape the designer sees (a long body with small fin holes stays meshable).
+fn metric_scale(s: &dyn Surface) -> f64 {
+    let dom = s.v_domain();
+    let (mut su, mut sv) = (0.0, 0.0);
+    for i in 0..9 {
+        for j in 0..9 {
+            let d = s.derivatives((i as f64 + 0.5) / 9.0, dom.at((j as f64 + 0.5) / 9.0), 1, 1);
+            su += d[2].norm();
+            sv += d[1].norm();
+        }
+    }
+    if su > 0.0 && sv > 0.0 && (sv / su).is_finite() { sv / su } else { 1.0 }
 }
 
 /// The curve `X_P(C(t))` for `trim = "P.C"`: trim curve `C` of the earlier patch `P`.
@@ -103,9 +134,8 @@ pub(super) fn trim_condition(ctx: &Ctx, name: &Spanned<String>, key: &str, done:
     let Some(t) = &p.trim else {
         return Err(ctx.err(span(name), key, format!("patch `{pname}` has no trim")));
     };
-    let region = t.map.region();
-    let Some((_, c)) = region.curves.iter().find(|(n, _)| n == cname) else {
-        let known: Vec<&str> = region.curves.iter().map(|(n, _)| n.as_str()).collect();
+    let Some((_, c)) = t.curves.iter().find(|(n, _)| n == cname) else {
+        let known: Vec<&str> = t.curves.iter().map(|(n, _)| n.as_str()).collect();
         return Err(ctx.err(
             span(name),
             key,

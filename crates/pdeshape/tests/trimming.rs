@@ -1,0 +1,134 @@
+//! Trimming (SPEC §7) through the scene files: every trim example meshes without folds,
+//! no mesh vertex lies inside a trim curve, the mesh boundary reproduces the trim curve,
+//! the dolphin's fins start on its trimmed body, and bad trims are refused.
+
+use assert_cmd::Command;
+use pdeshape_core::trim::inside_polygon;
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::path::PathBuf;
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
+}
+
+const TRIMMED: [&str; 5] =
+    ["trim-circle.toml", "trim-spline.toml", "trim-nonconvex.toml", "trim-disjoint.toml", "dolphin.toml"];
+
+#[test]
+fn trimmed_examples_have_no_folds_and_no_vertex_in_a_hole() {
+    for name in TRIMMED {
+        let scene = Scene::load(&example(name)).unwrap();
+        let mut trimmed = 0;
+        for p in scene.patches.iter() {
+            let Some(t) = &p.trim else { continue };
+            trimmed += 1;
+            let d = model::patch_diagnostics(p);
+            let tj = &d["trim"];
+            assert_eq!(tj["folds_after"], 0, "{name}: {tj}");
+            assert_eq!(tj["inside_after"], 0, "{name}: {tj}");
+            assert!(tj["boundary_error"].as_f64().unwrap() < 1e-10, "{name}: {tj}");
+            // independent check on the delivered mesh: its (u, v) against fine polygons of
+            // the curves in the patch's own parameters
+            let m = model::patch_mesh(p).unwrap();
+            let dom = p.surface.v_domain();
+            let polys: Vec<Vec<[f64; 2]>> =
+                t.curves.iter().map(|(_, c)| c.polygonize(400).into_iter().map(|x| x.1).collect()).collect();
+            let g = &t.grid;
+            for (k, uv) in m.uvs.iter().enumerate().skip(g.columns) {
+                let q = [uv[0], dom.start + uv[1] * (dom.end - dom.start)];
+                for (poly, (cname, curve)) in polys.iter().zip(&t.curves) {
+                    if inside_polygon(q, poly) {
+                        // only vertices within round-off of the curve may test inside
+                        assert!(curve.closest(q).1 < 1e-9, "{name}/{}: vertex {k} {q:?} inside `{cname}`", p.name);
+                    }
+                }
+            }
+            // ring 0 lies on a trim curve or a bridge, within 1e-10 in (u, v)
+            let k = t.scale;
+            let region = t.map.region();
+            for j in 0..g.columns {
+                let q = g.points[j];
+                let dist = region.loop_distance([q[0] * k[0], q[1] * k[1]]);
+                assert!(dist < 1e-10, "{name}: ring-0 vertex {j} is {dist} off the loop");
+            }
+            assert!(m.check_finite().is_ok());
+        }
+        assert!(trimmed >= 1, "{name} has no trimmed patch");
+    }
+}
+
+/// The fins' root conditions are the body's trim curves carried onto the body: the fin at
+/// u = 0 and the body at the trim curve are the same points.
+#[test]
+fn dolphin_fins_start_on_the_body() {
+    let scene = Scene::load(&example("dolphin.toml")).unwrap();
+    let body = scene.patch("body").unwrap();
+    let t = body.trim.as_ref().unwrap();
+    assert_eq!(t.map.region().bridges.len(), 2);
+    for (fin, curve) in [("dorsal", "dorsal"), ("right_fin", "right"), ("left_fin", "left")] {
+        let f = scene.patch(fin).unwrap();
+        let d = model::patch_diagnostics(f);
+        assert!(d["condition_error"]["max_rel"].as_f64().unwrap() < 1e-10, "{fin}: {}", d["condition_error"]);
+        let c = &t.curves.iter().find(|(n, _)| n == curve).unwrap().1;
+        for i in 0..200 {
+            let s = std::f64::consts::TAU * i as f64 / 200.0;
+            let uv = c.point(s);
+            let gap = (f.surface.point(0.0, s) - body.surface.point(uv[0], uv[1])).norm();
+            assert!(gap < 1e-10, "{fin} at t = {s}: {gap}");
+        }
+    }
+    assert!(scene.patch("flukes").is_some());
+}
+
+fn fails(scene: &str, expect: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.path().join("out.obj");
+    let o =
+        Command::cargo_bin("pdeshape").unwrap().arg("build").arg(&path).arg("-o").arg(&out).arg("-q").output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for e in expect {
+        assert!(err.contains(e), "expected `{e}` in\n{err}");
+    }
+    assert!(!out.exists());
+}
+
+const SHEET: &str = r#"
+[patches.p]
+kind = "hermite"
+v = [0, 1]
+conditions = [{ u = 0, expr = ["v", "0", "0"] }, { u = 1, expr = ["v", "1", "0"] }]
+"#;
+
+#[test]
+fn bad_trims_are_refused_with_the_place_and_the_cause() {
+    fails(
+        &format!("{SHEET}\n[patches.p.trim.curves.big]\ncircle = {{ center = [0.5, 0.5], radius = 0.6 }}\n"),
+        &["scene.toml:", "patches.p.trim", "`big` leaves the parameter domain"],
+    );
+    fails(
+        &format!("{SHEET}\n[patches.p.trim.curves.bow]\npolygon = [[0.2, 0.2], [0.8, 0.8], [0.8, 0.2], [0.2, 0.8]]\n"),
+        &["patches.p.trim", "`bow` intersects itself"],
+    );
+    fails(
+        &format!(
+            "{SHEET}\n[patches.p.trim.curves.a]\ncircle = {{ center = [0.4, 0.5], radius = 0.2 }}\n\
+             [patches.p.trim.curves.b]\ncircle = {{ center = [0.6, 0.5], radius = 0.2 }}\n"
+        ),
+        &["trim curves `a` and `b` intersect"],
+    );
+    fails(
+        &format!("{SHEET}\n[patches.p.trim.curves.c]\ncircle = {{ center = [0.5, 0.5] }}\n"),
+        &["patches.p.trim.curves.c.circle", "exactly one of `radius` and `radii`"],
+    );
+    fails(
+        &format!(
+            "{SHEET}\n[patches.q]\nkind = \"hermite\"\nconditions = [{{ u = 0, trim = \"p.hole\" }}, {{ u = 1, expr = [\"v\", \"1\", \"0\"] }}]\n"
+        ),
+        &["patches.q.conditions[0].trim", "patch `p` has no trim"],
+    );
+}
