@@ -61,6 +61,19 @@ fn dynamic_animation(
     Ok(anim)
 }
 
+/// The mesh of a patch at time `t` (dynamic blends; other patches ignore `t`).
+pub fn patch_mesh_at(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
+    match (&p.dynamic, t) {
+        (Some(d), Some(t)) => {
+            let mut m = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
+            m.name = p.name.clone();
+            m.check_finite()?;
+            Ok(m)
+        }
+        _ => patch_mesh(p),
+    }
+}
+
 /// The frame meshes of a dynamic patch (`None` for other patches), named `PATCH-NNN`.
 pub fn frame_meshes(p: &ScenePatch) -> Option<Result<Vec<Mesh>, String>> {
     let d = p.dynamic.as_ref()?;

@@ -114,10 +114,19 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Serve the interactive editor on localhost.
+    /// Serve the interactive editor (a local web page) on 127.0.0.1.
     Serve {
-        /// Scene to open.
+        /// Scene to open (default: a chooser of the built-in examples).
         scene: Option<PathBuf>,
+        /// Port (0 picks a free one).
+        #[arg(long, default_value_t = 8080)]
+        port: u16,
+        /// Address to bind; anything but loopback exposes the editor to the network.
+        #[arg(long, default_value = "127.0.0.1")]
+        host: String,
+        /// Print the URL to open (it is always printed on start).
+        #[arg(long)]
+        open: bool,
     },
 }
 
@@ -435,8 +444,8 @@ fn execute(cli: Cli) -> Result<()> {
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, cli.quiet),
         Command::Bench { json, runs, out } => crate::bench::run(runs, json, out.as_deref()),
-        Command::Serve { .. } => {
-            bail!("`pdeshape serve` is not available in this version: the web editor is not implemented yet")
+        Command::Serve { scene, port, host, open: _ } => {
+            crate::serve::run(crate::serve::ServeOptions { scene, host, port })
         }
     }
 }

@@ -4,6 +4,7 @@
 mod bench;
 mod cli;
 mod gallery;
+mod serve;
 
 include!(concat!(env!("OUT_DIR"), "/examples.rs"));
 

@@ -133,10 +133,16 @@ fn gallery_builds_an_index_with_pictures() {
 }
 
 #[test]
-fn not_yet_available_commands_say_so() {
-    let o = Command::cargo_bin("pdeshape").unwrap().arg("serve").output().unwrap();
+fn serve_refuses_a_broken_scene_before_listening() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.toml");
+    std::fs::write(&path, "[patches.p\n").unwrap();
+    let o = Command::cargo_bin("pdeshape").unwrap().arg("serve").arg(&path).args(["--port", "0"]).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not available"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("broken.toml:1:"), "{err}");
+    let o = Command::cargo_bin("pdeshape").unwrap().args(["serve", "--port", "not-a-port"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
 }
 
 /// `bench --json` reproduces paper 002's Table 1 beside the published figures and the

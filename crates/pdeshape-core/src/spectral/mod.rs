@@ -86,8 +86,8 @@ pub struct SpectralPatch {
     conds: Vec<CondSpec>,
     data: Vec<FieldRef>,
     series: Vec<FourierSeries>,
-    cards: Vec<CardinalSet>,
-    rem: CardinalSet,
+    cards: Vec<Arc<CardinalSet>>,
+    rem: Arc<CardinalSet>,
     time: f64,
     cache: Mutex<HashMap<(u64, usize), Arc<Row>>>,
 }
@@ -119,6 +119,28 @@ pub struct SpectralReport {
 
 fn describe(conds: &[CondSpec]) -> String {
     conds.iter().map(|c| format!("∂^{} at u = {}", c.order, c.u)).collect::<Vec<_>>().join(", ")
+}
+
+/// Cardinal functions of `ExpSpace::symmetric(rate, n)` for the condition set, memoised
+/// process-wide: they depend only on the operator and the condition positions, not on the
+/// data, so re-solving with new boundary curves (a designer dragging a curve or a section
+/// parameter) reuses them. Bounded: the memo is emptied when it holds 256 sets.
+fn cardinal_set(rate: f64, n: usize, specs: &[CondSpec], kmax: usize) -> Result<Arc<CardinalSet>, OdeError> {
+    type Key = (u64, usize, Vec<(u64, usize)>, usize);
+    static MEMO: std::sync::OnceLock<Mutex<HashMap<Key, Arc<CardinalSet>>>> = std::sync::OnceLock::new();
+    let key: Key = (rate.to_bits(), n, specs.iter().map(|c| (c.u.to_bits(), c.order)).collect(), kmax);
+    let memo = MEMO.get_or_init(Default::default);
+    if let Some(c) = memo.lock().ok().and_then(|m| m.get(&key).cloned()) {
+        return Ok(c);
+    }
+    let c = Arc::new(CardinalSet::new(ExpSpace::symmetric(rate, n), specs, kmax)?);
+    if let Ok(mut m) = memo.lock() {
+        if m.len() >= 256 {
+            m.clear();
+        }
+        m.insert(key, c.clone());
+    }
+    Ok(c)
 }
 
 impl SpectralPatch {
@@ -161,15 +183,21 @@ impl SpectralPatch {
         let series: Vec<FourierSeries> =
             data.par_iter().map(|g| FourierSeries::analyse(|th| g.eval(&[th, 0.0]), opts.modes, samples)).collect();
         let what = describe(&specs);
-        let cards: Vec<CardinalSet> = (0..=opts.modes)
+        let cards: Vec<Arc<CardinalSet>> = (0..=opts.modes)
             .into_par_iter()
             .map(|m| {
-                CardinalSet::new(ExpSpace::symmetric(opts.a * m as f64, n), &specs, kmax)
-                    .map_err(|source| SpectralError::Conditions { mode: m.to_string(), what: what.clone(), source })
+                cardinal_set(opts.a * m as f64, n, &specs, kmax).map_err(|source| SpectralError::Conditions {
+                    mode: m.to_string(),
+                    what: what.clone(),
+                    source,
+                })
             })
             .collect::<Result<_, _>>()?;
-        let rem = CardinalSet::new(ExpSpace::symmetric(omega, n), &specs, kmax)
-            .map_err(|source| SpectralError::Conditions { mode: format!("ω = {omega}"), what, source })?;
+        let rem = cardinal_set(omega, n, &specs, kmax).map_err(|source| SpectralError::Conditions {
+            mode: format!("ω = {omega}"),
+            what,
+            source,
+        })?;
         Ok(SpectralPatch {
             domain,
             dtheta_dv,
@@ -204,7 +232,7 @@ impl SpectralPatch {
     /// Diagnostics.
     pub fn report(&self) -> SpectralReport {
         let max_mode_condition = self.cards.iter().map(|c| c.condition_number()).fold(0.0, f64::max);
-        let mp = self.cards.iter().filter(|c| matches!(c, CardinalSet::Tabulated(_))).count();
+        let mp = self.cards.iter().filter(|c| matches!(c.as_ref(), CardinalSet::Tabulated(_))).count();
         SpectralReport {
             order: 2 * self.n,
             modes: self.opts.modes,

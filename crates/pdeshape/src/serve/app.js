@@ -1,0 +1,435 @@
+// pdeshape editor: WebGL2 view, parameter sliders, handles, trim editor, diagnostics.
+// State exposed for tests as window.pdeshape.
+"use strict";
+const S = window.pdeshape = {
+  frames: 0, vertexCount: 0, meshHash: "", lastError: null, diagnostics: null,
+  lastDownload: null, requests: 0, header: null,
+};
+const $ = (id) => document.getElementById(id);
+let scene = { name: "scene", text: "" };
+let params = {};          // name -> value
+let time = null;
+let model = null;         // { header, gl buffers per patch }
+let pending = false, inflight = false, wantDiag = false;
+S.busy = () => inflight || pending;
+
+// ---------------- camera ----------------
+const cam = { az: 0.6, el: 0.45, dist: 10, target: [0, 0, 0], fov: 0.8 };
+function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
+function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
+function scl(a, s) { return [a[0] * s, a[1] * s, a[2] * s]; }
+function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+function crs(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+function nrm(a) { const l = Math.hypot(a[0], a[1], a[2]) || 1; return scl(a, 1 / l); }
+function eye() {
+  const d = [Math.cos(cam.el) * Math.cos(cam.az), Math.cos(cam.el) * Math.sin(cam.az), Math.sin(cam.el)];
+  return add(cam.target, scl(d, cam.dist));
+}
+function basis() {
+  const f = nrm(sub(cam.target, eye()));
+  const r = nrm(crs(f, [0, 0, 1]));
+  const u = crs(r, f);
+  return { f, r, u };
+}
+function matrices(w, h) {
+  const e = eye(), { f, r, u } = basis();
+  const view = [r[0], u[0], -f[0], 0, r[1], u[1], -f[1], 0, r[2], u[2], -f[2], 0,
+    -dot(r, e), -dot(u, e), dot(f, e), 1];
+  const near = cam.dist / 100, far = cam.dist * 100, t = 1 / Math.tan(cam.fov / 2), a = w / h;
+  const proj = [t / a, 0, 0, 0, 0, t, 0, 0, 0, 0, (far + near) / (near - far), -1, 0, 0, 2 * far * near / (near - far), 0];
+  return { view, proj };
+}
+function mul4(a, b) { // column-major a*b
+  const o = new Array(16).fill(0);
+  for (let c = 0; c < 4; c++) for (let r = 0; r < 4; r++) for (let k = 0; k < 4; k++) o[c * 4 + r] += a[k * 4 + r] * b[c * 4 + k];
+  return o;
+}
+function project(p, w, h) {
+  const { view, proj } = matrices(w, h);
+  const m = mul4(proj, view);
+  const x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
+  const y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
+  const ww = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
+  return [(x / ww * 0.5 + 0.5) * w, (1 - (y / ww * 0.5 + 0.5)) * h, ww];
+}
+
+// ---------------- WebGL ----------------
+const canvas = $("gl");
+const gl = canvas.getContext("webgl2", { preserveDrawingBuffer: true, antialias: true });
+if (!gl) { $("error").style.display = "block"; $("error").textContent = "WebGL2 is not available in this browser."; }
+function shader(type, src) {
+  const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+  return s;
+}
+function program(vs, fs) {
+  const p = gl.createProgram();
+  gl.attachShader(p, shader(gl.VERTEX_SHADER, vs)); gl.attachShader(p, shader(gl.FRAGMENT_SHADER, fs));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
+  return p;
+}
+const surf = program(`#version 300 es
+layout(location=0) in vec3 pos; layout(location=1) in vec3 nor; layout(location=2) in float fld;
+uniform mat4 view, proj; out vec3 vn; out vec3 vp; out float vf;
+void main() { vn = mat3(view) * nor; vec4 q = view * vec4(pos, 1.0); vp = q.xyz; vf = fld; gl_Position = proj * q; }`,
+`#version 300 es
+precision highp float; in vec3 vn; in vec3 vp; in float vf; uniform vec3 color; uniform int useField;
+uniform vec2 range; out vec4 o;
+vec3 cmap(float t) { t = clamp(t, 0.0, 1.0);
+  return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0); }
+void main() {
+  vec3 n = normalize(vn); vec3 v = normalize(-vp); if (dot(n, v) < 0.0) n = -n;
+  vec3 base = useField == 1 ? cmap((vf - range.x) / max(range.y - range.x, 1e-30)) : color;
+  float d = max(dot(n, v), 0.0); float s = pow(max(dot(reflect(-v, n), v), 0.0), 40.0);
+  o = vec4(base * (0.25 + 0.75 * d) + vec3(0.25 * s), 1.0); }`);
+const flat = program(`#version 300 es
+layout(location=0) in vec3 pos; uniform mat4 view, proj; uniform float size;
+void main() { gl_Position = proj * view * vec4(pos, 1.0); gl_Position.z -= 0.0005 * gl_Position.w; gl_PointSize = size; }`,
+`#version 300 es
+precision highp float; uniform vec4 color; out vec4 o; void main() { o = color; }`);
+
+function upload(header, bytes) {
+  const f32 = (r) => new Float32Array(bytes, r.offset, r.count);
+  const u32 = (r) => new Uint32Array(bytes, r.offset, r.count);
+  const patches = header.patches.map((p) => {
+    const vao = gl.createVertexArray(); gl.bindVertexArray(vao);
+    const buf = (data, loc, size) => {
+      const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b); gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, size, gl.FLOAT, false, 0, 0); return b;
+    };
+    buf(f32(p.positions), 0, 3); buf(f32(p.normals), 1, 3);
+    const fieldBuf = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, fieldBuf);
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(p.vertices), gl.DYNAMIC_DRAW);
+    gl.enableVertexAttribArray(2); gl.vertexAttribPointer(2, 1, gl.FLOAT, false, 0, 0);
+    const ib = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, u32(p.indices), gl.STATIC_DRAW);
+    gl.bindVertexArray(null);
+    const lvao = gl.createVertexArray(); gl.bindVertexArray(lvao);
+    buf(f32(p.positions), 0, 3);
+    const lb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, lb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, u32(p.lines), gl.STATIC_DRAW);
+    gl.bindVertexArray(null);
+    const curves = p.curves.map((c) => {
+      const v = gl.createVertexArray(); gl.bindVertexArray(v); buf(f32(c), 0, 3); gl.bindVertexArray(null);
+      return { vao: v, n: c.count / 3 };
+    });
+    const fields = {};
+    for (const fl of p.fields) fields[fl.name] = f32(fl);
+    return { vao, lvao, fieldBuf, n: p.indices.count, nl: p.lines.count, curves, fields, meta: p,
+      pos: f32(p.positions).slice() };
+  });
+  return patches;
+}
+function bounds(patches) {
+  let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (const p of patches) for (let i = 0; i < p.pos.length; i += 3)
+    for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p.pos[i + k]); hi[k] = Math.max(hi[k], p.pos[i + k]); }
+  return { lo, hi };
+}
+let handleVao = null, handleCount = 0;
+function uploadHandles() {
+  const h = model ? model.header.editables.handles : [];
+  const data = new Float32Array(h.flatMap((x) => x.position));
+  if (!handleVao) handleVao = gl.createVertexArray();
+  gl.bindVertexArray(handleVao);
+  const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b); gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+  gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+  gl.bindVertexArray(null); handleCount = h.length;
+}
+const PALETTE = [[0.36, 0.55, 0.85], [0.86, 0.55, 0.3], [0.45, 0.72, 0.45], [0.75, 0.45, 0.72], [0.8, 0.75, 0.35]];
+function draw() {
+  const w = canvas.clientWidth * devicePixelRatio, h = canvas.clientHeight * devicePixelRatio;
+  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+  gl.viewport(0, 0, w, h); gl.clearColor(0.93, 0.95, 0.98, 1); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  gl.enable(gl.DEPTH_TEST);
+  if (!model) return;
+  const { view, proj } = matrices(w, h);
+  const field = $("field").value;
+  gl.useProgram(surf);
+  gl.uniformMatrix4fv(gl.getUniformLocation(surf, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(surf, "proj"), false, proj);
+  model.patches.forEach((p, i) => {
+    const c = p.meta.color || PALETTE[i % PALETTE.length];
+    gl.uniform3fv(gl.getUniformLocation(surf, "color"), c);
+    const fv = field && p.fields[field];
+    gl.uniform1i(gl.getUniformLocation(surf, "useField"), fv ? 1 : 0);
+    if (fv) {
+      let lo = Infinity, hi = -Infinity; for (const x of fv) { lo = Math.min(lo, x); hi = Math.max(hi, x); }
+      gl.uniform2f(gl.getUniformLocation(surf, "range"), lo, hi);
+      gl.bindBuffer(gl.ARRAY_BUFFER, p.fieldBuf); gl.bufferData(gl.ARRAY_BUFFER, fv, gl.DYNAMIC_DRAW);
+    }
+    gl.bindVertexArray(p.vao); gl.drawElements(gl.TRIANGLES, p.n, gl.UNSIGNED_INT, 0);
+  });
+  gl.useProgram(flat);
+  gl.uniformMatrix4fv(gl.getUniformLocation(flat, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(flat, "proj"), false, proj);
+  if ($("wire").checked) {
+    gl.uniform4f(gl.getUniformLocation(flat, "color"), 0.1, 0.15, 0.25, 0.6);
+    for (const p of model.patches) { gl.bindVertexArray(p.lvao); gl.drawElements(gl.LINES, p.nl, gl.UNSIGNED_INT, 0); }
+  }
+  gl.uniform4f(gl.getUniformLocation(flat, "color"), 0.8, 0.1, 0.1, 1);
+  for (const p of model.patches) for (const c of p.curves) { gl.bindVertexArray(c.vao); gl.drawArrays(gl.LINE_STRIP, 0, c.n); }
+  if ($("handles").checked && handleCount) {
+    gl.disable(gl.DEPTH_TEST);
+    gl.uniform1f(gl.getUniformLocation(flat, "size"), 9 * devicePixelRatio);
+    gl.uniform4f(gl.getUniformLocation(flat, "color"), 0.95, 0.6, 0.05, 1);
+    gl.bindVertexArray(handleVao); gl.drawArrays(gl.POINTS, 0, handleCount);
+  }
+  gl.bindVertexArray(null);
+  S.frames++;
+}
+let drawQueued = false;
+function redraw() { if (!drawQueued) { drawQueued = true; requestAnimationFrame(() => { drawQueued = false; draw(); }); } }
+
+// ---------------- server ----------------
+let edits = [];            // edits not yet folded into scene.text
+function showError(msg) {
+  S.lastError = msg; const e = $("error");
+  e.style.display = msg ? "block" : "none"; e.textContent = msg || "";
+}
+async function solve(diagnostics) {
+  if (inflight) { pending = true; wantDiag ||= diagnostics; return; }
+  inflight = true;
+  const body = { text: scene.text, name: scene.name, params, edits, time, diagnostics };
+  const sent = edits; S.requests++;
+  try {
+    const r = await fetch("/api/model", { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
+    if (!r.ok) {
+      const e = await r.json().catch(() => ({ error: r.statusText }));
+      showError(e.error);   // the edit is kept in the editor and shown as invalid, the model is not replaced
+    } else {
+      const bytes = await r.arrayBuffer();
+      const n = new DataView(bytes).getUint32(0, true);
+      const header = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 4, n)));
+      const data = bytes.slice(4 + n);
+      const first = !model;
+      if (edits === sent) { scene.text = header.text; edits = []; }
+      model = { header, patches: upload(header, data) };
+      S.header = header; S.meshHash = header.hash;
+      S.vertexCount = header.patches.reduce((a, p) => a + p.vertices, 0);
+      if (header.diagnostics) { S.diagnostics = header.diagnostics; $("diag").textContent = summary(header.diagnostics); }
+      showError(null);
+      if (first) { fit(); buildPanel(header); }
+      syncPanel(header); uploadHandles(); drawTrim(); redraw();
+      $("status").textContent = `${header.title || header.name}: ${S.vertexCount} vertices, solved in ${header.solve_ms.toFixed(1)} ms, hash ${header.hash}`;
+    }
+  } catch (e) { showError(String(e)); }
+  inflight = false;
+  if (pending) { pending = false; const d = wantDiag; wantDiag = false; solve(d); }
+}
+function summary(d) {
+  const lines = [];
+  for (const p of d.patches) {
+    lines.push(`${p.name} (${p.kind}, ${p.solver}): max condition error ${Number(p.condition_error?.max_rel).toExponential(2)} rel`);
+    if (p.continuity) lines.push(`  continuity ${p.continuity.class}`);
+    if (p.trim) lines.push(`  trim: folds ${p.trim.folds_before} → ${p.trim.folds_after}, angles ${p.trim.min_angle_deg.toFixed(1)}–${p.trim.max_angle_deg.toFixed(1)}°, area ratio ${p.trim.area_ratio.toFixed(4)}`);
+    for (const w of p.warnings || []) lines.push(`  warning: ${w}`);
+  }
+  return lines.join("\n") + "\n\n" + JSON.stringify(d, null, 1);
+}
+let diagTimer = null;
+function changed() { solve(false); clearTimeout(diagTimer); diagTimer = setTimeout(() => solve(true), 400); }
+function fit() {
+  const b = bounds(model.patches);
+  cam.target = scl(add(b.lo, b.hi), 0.5);
+  const v = model.header.view;
+  if (v) { cam.az = v.azimuth * Math.PI / 180; cam.el = v.elevation * Math.PI / 180; }
+  cam.dist = 1.6 * Math.max(1e-3, Math.hypot(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]));
+}
+
+// ---------------- panel ----------------
+function buildPanel(h) {
+  const box = $("params"); box.innerHTML = "";
+  for (const p of h.params) {
+    if (p.derived) continue;
+    const lo = p.min ?? (p.value === 0 ? -1 : Math.min(0, 2 * p.value)), hi = p.max ?? (p.value === 0 ? 1 : Math.max(0, 2 * p.value));
+    const row = document.createElement("div"); row.className = "param"; row.title = p.description || "";
+    row.innerHTML = `<span>${p.name}</span><input type="range" data-param="${p.name}" min="${lo}" max="${hi}" step="${p.step ?? (hi - lo) / 500}" value="${p.value}"><input type="number" data-num="${p.name}" value="${p.value}" step="any">`;
+    box.appendChild(row);
+  }
+  box.querySelectorAll("input").forEach((el) => el.addEventListener("input", () => {
+    const name = el.dataset.param || el.dataset.num, v = parseFloat(el.value);
+    if (!Number.isFinite(v)) return;
+    params[name] = v;
+    box.querySelectorAll(`[data-param="${name}"],[data-num="${name}"]`).forEach((o) => { if (o !== el) o.value = v; });
+    changed();
+  }));
+  const fs = $("field"); fs.innerHTML = `<option value="">shading</option>`;
+  const names = new Set(h.patches.flatMap((p) => p.fields.map((f) => f.name)));
+  for (const n of names) fs.innerHTML += `<option>${n}</option>`;
+  if (h.time_range) {
+    $("timebox").style.display = "block";
+    const t = $("time"); t.min = h.time_range[0]; t.max = h.time_range[1]; t.step = (h.time_range[1] - h.time_range[0]) / 200;
+    t.value = h.time_range[0]; time = h.time_range[0];
+  } else { $("timebox").style.display = "none"; time = null; }
+  $("trimbox").style.display = h.patches.some((p) => p.trim) ? "block" : "none";
+  const dl = $("downloads"); dl.innerHTML = "";
+  for (const f of ["obj", "ply", "stl", "glb", "vtu"]) {
+    const b = document.createElement("button"); b.textContent = f.toUpperCase(); b.dataset.format = f;
+    b.onclick = () => download(f); dl.appendChild(b);
+  }
+  const sb = document.createElement("button"); sb.textContent = "scene .toml"; sb.dataset.format = "toml";
+  sb.onclick = () => { const t = model ? model.header.text : scene.text; save(new Blob([t], { type: "text/plain" }), `${scene.name}.toml`, t.length); };
+  dl.appendChild(sb);
+}
+function syncPanel(h) { $("title").textContent = h.title || h.name; }
+function save(blob, name, bytes) {
+  const a = document.createElement("a"); a.href = URL.createObjectURL(blob); a.download = name; a.click();
+  S.lastDownload = { name, bytes };
+}
+async function download(format) {
+  // the current model: the last text the server accepted (an invalid edit is not in it)
+  const body = { text: model ? model.header.text : scene.text, name: scene.name, params, edits: [], time };
+  const r = await fetch(`/api/export?format=${format}`, { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
+  if (!r.ok) { showError((await r.json()).error); return; }
+  const b = await r.blob();
+  S.lastDownloadText = format === "obj" ? (await b.text()).slice(0, 200) : null;
+  save(b, `${scene.name}.${format}`, b.size);
+}
+$("wire").onchange = redraw; $("handles").onchange = redraw; $("field").onchange = redraw;
+$("time").addEventListener("input", () => { time = parseFloat($("time").value); changed(); });
+let playing = null;
+$("play").onclick = () => {
+  if (playing) { clearInterval(playing); playing = null; $("play").textContent = "play"; return; }
+  $("play").textContent = "pause";
+  playing = setInterval(() => {
+    const t = $("time"); let v = parseFloat(t.value) + parseFloat(t.step);
+    if (v > parseFloat(t.max)) v = parseFloat(t.min);
+    t.value = v; time = v; if (!inflight) solve(false);
+  }, 50);
+};
+
+// ---------------- 3D interaction ----------------
+let drag = null;
+function pickHandle(x, y) {
+  if (!$("handles").checked || !model) return null;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  let best = null, bd = 12;
+  model.header.editables.handles.forEach((hd, i) => {
+    const [sx, sy, ww] = project(hd.position, w, h);
+    const d = Math.hypot(sx - x, sy - y);
+    if (ww > 0 && d < bd) { bd = d; best = i; }
+  });
+  return best;
+}
+S.handleScreenPos = (i) => {
+  const r = canvas.getBoundingClientRect();
+  const [x, y] = project(model.header.editables.handles[i].position, canvas.clientWidth, canvas.clientHeight);
+  return [r.left + x, r.top + y];
+};
+canvas.addEventListener("contextmenu", (e) => e.preventDefault());
+canvas.addEventListener("pointerdown", (e) => {
+  canvas.setPointerCapture(e.pointerId);
+  const h = pickHandle(e.offsetX, e.offsetY);
+  if (h !== null) {
+    const hd = model.header.editables.handles[h];
+    drag = { kind: "handle", index: h, x: e.offsetX, y: e.offsetY, start: hd.position.slice(), path: hd.path };
+  } else drag = { kind: e.shiftKey || e.button === 2 ? "pan" : "orbit", x: e.offsetX, y: e.offsetY };
+});
+canvas.addEventListener("pointermove", (e) => {
+  if (!drag) return;
+  const dx = e.offsetX - drag.x, dy = e.offsetY - drag.y;
+  const px = 2 * cam.dist * Math.tan(cam.fov / 2) / canvas.clientHeight;
+  const { r, u } = basis();
+  if (drag.kind === "orbit") {
+    cam.az -= dx * 0.01; cam.el = Math.max(-1.55, Math.min(1.55, cam.el + dy * 0.01)); drag.x = e.offsetX; drag.y = e.offsetY; redraw();
+  } else if (drag.kind === "pan") {
+    cam.target = add(cam.target, add(scl(r, -dx * px), scl(u, dy * px))); drag.x = e.offsetX; drag.y = e.offsetY; redraw();
+  } else {
+    let move = add(scl(r, dx * px), scl(u, -dy * px));
+    const axis = $("axis").value;
+    if (axis) {
+      // move along the world axis by the screen drag projected onto the axis' screen direction
+      const a = [0, 0, 0]; a[" xyz".indexOf(axis) - 1] = 1;
+      const sx = dot(a, r), sy = -dot(a, u), s2 = Math.max(sx * sx + sy * sy, 1e-6);
+      move = scl(a, (dx * sx + dy * sy) * px / s2);
+    }
+    const p = add(drag.start, move).map((v) => Math.round(v * 1e6) / 1e6);
+    model.header.editables.handles[drag.index].position = p;
+    edits = edits.filter((ed) => JSON.stringify(ed.path) !== JSON.stringify(drag.path));
+    edits.push({ op: "set", path: drag.path, value: p });
+    uploadHandles(); redraw(); changed();
+  }
+});
+canvas.addEventListener("pointerup", () => { drag = null; });
+canvas.addEventListener("wheel", (e) => { e.preventDefault(); cam.dist *= Math.exp(e.deltaY * 0.001); redraw(); }, { passive: false });
+window.addEventListener("resize", redraw);
+
+// ---------------- trim editor (parameter space) ----------------
+const t2 = $("trim2d"), c2 = t2.getContext("2d");
+let tdrag = null;
+function trimPatch() { return model && model.header.patches.find((p) => p.trim); }
+function trimMap() {
+  const p = trimPatch(); if (!p) return null;
+  const [[u0, v0], [u1, v1]] = p.trim.domain, pad = 10, W = t2.width - 2 * pad, H = t2.height - 2 * pad;
+  return { p, to: (q) => [pad + (q[0] - u0) / (u1 - u0) * W, pad + (1 - (q[1] - v0) / (v1 - v0)) * H],
+    from: (x, y) => [u0 + (x - pad) / W * (u1 - u0), v0 + (1 - (y - pad) / H) * (v1 - v0)] };
+}
+function trimItems() { const p = trimPatch(); return p ? model.header.editables.trims.filter((t) => t.patch === p.name) : []; }
+function drawTrim() {
+  const m = trimMap(); c2.clearRect(0, 0, t2.width, t2.height); if (!m) return;
+  const line = (pts, col, w, close) => {
+    c2.strokeStyle = col; c2.lineWidth = w; c2.beginPath();
+    pts.forEach((q, i) => { const [x, y] = m.to(q); i ? c2.lineTo(x, y) : c2.moveTo(x, y); });
+    if (close) c2.closePath(); c2.stroke();
+  };
+  const t = m.p.trim;
+  for (const s of t.spokes) line(s, "#e3a0a0", 1);
+  for (const r of t.rings) line(r, "#a0b0e0", 1);
+  line([t.domain[0], [t.domain[1][0], t.domain[0][1]], t.domain[1], [t.domain[0][0], t.domain[1][1]]], "#333", 2, true);
+  line(t.loop, "#000", 2);
+  for (const it of trimItems()) {
+    if (it.kind !== "circle") line(it.points, "#f0a020", 1, true);
+    for (const q of it.points) { const [x, y] = m.to(q); c2.fillStyle = "#f08c00"; c2.fillRect(x - 4, y - 4, 8, 8); }
+  }
+}
+function trimHit(x, y) {
+  const m = trimMap(); if (!m) return null;
+  for (const it of trimItems()) for (let i = 0; i < it.points.length; i++) {
+    const [px, py] = m.to(it.points[i]); if (Math.hypot(px - x, py - y) < 7) return { it, i };
+  }
+  return null;
+}
+S.trimPointScreenPos = (k, i) => {
+  const m = trimMap(), r = t2.getBoundingClientRect(), [x, y] = m.to(trimItems()[k].points[i]);
+  return [r.left + x, r.top + y];
+};
+function trimEdit(e) { edits.push(e); changed(); drawTrim(); }
+t2.addEventListener("contextmenu", (e) => {
+  e.preventDefault(); const h = trimHit(e.offsetX, e.offsetY);
+  if (h && h.it.kind !== "circle") { h.it.points.splice(h.i, 1); trimEdit({ op: "delete", path: [...h.it.path, h.i] }); }
+});
+t2.addEventListener("dblclick", (e) => {
+  const m = trimMap(); if (!m) return; const q = m.from(e.offsetX, e.offsetY);
+  let best = null, bd = Infinity;
+  for (const it of trimItems()) {
+    if (it.kind === "circle") continue;
+    it.points.forEach((a, i) => {
+      const b = it.points[(i + 1) % it.points.length], mid = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+      const d = Math.hypot(mid[0] - q[0], mid[1] - q[1]); if (d < bd) { bd = d; best = { it, i: i + 1 }; }
+    });
+  }
+  if (best) { best.it.points.splice(best.i, 0, q); trimEdit({ op: "insert", path: [...best.it.path, best.i], value: q }); }
+});
+t2.addEventListener("pointerdown", (e) => { const h = trimHit(e.offsetX, e.offsetY); if (h && e.button === 0) { tdrag = h; t2.setPointerCapture(e.pointerId); } });
+t2.addEventListener("pointermove", (e) => {
+  if (!tdrag) return; const m = trimMap(); const q = m.from(e.offsetX, e.offsetY).map((v) => Math.round(v * 1e6) / 1e6);
+  tdrag.it.points[tdrag.i] = q;
+  const path = tdrag.it.kind === "circle" ? tdrag.it.path : [...tdrag.it.path, tdrag.i];
+  edits = edits.filter((ed) => JSON.stringify(ed.path) !== JSON.stringify(path) || ed.op !== "set");
+  edits.push({ op: "set", path, value: q }); changed(); drawTrim();
+});
+t2.addEventListener("pointerup", () => { tdrag = null; });
+
+// ---------------- start ----------------
+async function open(name, text) {
+  scene = { name, text }; params = {}; edits = []; model = null; solve(true);
+}
+(async () => {
+  const ex = await (await fetch("/api/examples")).json();
+  const sel = $("examples");
+  sel.innerHTML = `<option value="">— examples —</option>` + ex.map((n) => `<option>${n}</option>`).join("");
+  sel.onchange = async () => { if (!sel.value) return; const e = await (await fetch(`/api/example/${sel.value}`)).json(); open(e.name, e.text); };
+  const init = await (await fetch("/api/initial")).json();
+  if (init) open(init.name, init.text);
+  else { const e = await (await fetch(`/api/example/${ex[0]}`)).json(); sel.value = ex[0]; open(e.name, e.text); }
+})();

@@ -1,0 +1,131 @@
+//! Load on the editor's API over loopback: concurrent clients sending parameter changes get
+//! correct answers (the mesh the library computes for the same value) and no error.
+
+use pdeshape_io::model;
+use pdeshape_io::scene::{LoadOptions, Scene};
+use serde_json::{Value, json};
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::Instant;
+
+struct Kill(Child);
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn example(name: &str) -> String {
+    std::fs::read_to_string(std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name))
+        .unwrap()
+}
+
+fn serve() -> (Kill, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .args(["serve", "--port", "0"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+    (Kill(child), line.trim().rsplit(' ').next().unwrap().to_string())
+}
+
+/// The page's fingerprint: FNV-1a over the f32 bits of every position.
+fn hash(scene: &Scene) -> String {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for p in &scene.patches {
+        for q in model::patch_mesh(p).unwrap().positions {
+            for x in [q.x as f32, q.y as f32, q.z as f32] {
+                for b in x.to_le_bytes() {
+                    h ^= b as u64;
+                    h = h.wrapping_mul(0x100000001b3);
+                }
+            }
+        }
+    }
+    format!("{h:016x}")
+}
+
+fn header(body: &[u8]) -> Value {
+    let n = u32::from_le_bytes(body[..4].try_into().unwrap()) as usize;
+    serde_json::from_slice(&body[4..4 + n]).unwrap()
+}
+
+/// `clients` threads each send `changes` values of `param`; returns the latencies (ms).
+fn load(url: &str, text: &str, param: &str, values: &[f64], clients: usize, changes: usize) -> Vec<f64> {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..clients)
+            .map(|c| {
+                s.spawn(move || {
+                    let agent = ureq::Agent::new_with_defaults();
+                    let mut lat = Vec::new();
+                    for k in 0..changes {
+                        let v = values[(c * 7 + k) % values.len()];
+                        let body = json!({"text": text, "name": "load", "params": {param: v}});
+                        let t = Instant::now();
+                        let mut r = agent
+                            .post(format!("{url}api/model"))
+                            .header("content-type", "application/json")
+                            .send(serde_json::to_vec(&body).unwrap())
+                            .unwrap();
+                        let bytes = r.body_mut().with_config().limit(1 << 30).read_to_vec().unwrap();
+                        lat.push(t.elapsed().as_secs_f64() * 1e3);
+                        let h = header(&bytes);
+                        let got = h["params"].as_array().unwrap().iter().find(|p| p["name"] == param).unwrap();
+                        assert_eq!(got["value"].as_f64().unwrap(), v);
+                        assert_eq!(h["hash"].as_str().unwrap(), expected(text, param, v), "client {c}, change {k}");
+                    }
+                    lat
+                })
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().unwrap()).collect()
+    })
+}
+
+fn expected(text: &str, param: &str, v: f64) -> String {
+    use std::sync::{Mutex, OnceLock};
+    static CACHE: OnceLock<Mutex<HashMap<(String, u64), String>>> = OnceLock::new();
+    let key = (param.to_string(), v.to_bits());
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(h) = cache.lock().unwrap().get(&key) {
+        return h.clone();
+    }
+    let opts = LoadOptions { params: HashMap::from([(param.to_string(), v)]), ..Default::default() };
+    let h = hash(&Scene::parse_with(text, "load.toml", "load", &opts).unwrap());
+    cache.lock().unwrap().insert(key, h.clone());
+    h
+}
+
+fn percentile(v: &mut [f64], q: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+#[test]
+fn eight_clients_get_correct_meshes() {
+    let (_server, url) = serve();
+    let text = example("four-curve-patch.toml");
+    let values: Vec<f64> = (0..10).map(|i| 0.8 + 0.1 * i as f64).collect();
+    let lat = load(&url, &text, "a", &values, 8, 25);
+    assert_eq!(lat.len(), 200);
+}
+
+/// The load test: 8 clients × 200 changes of the Klein bottle's `a` at 100 × 100
+/// (minutes; run with `cargo test --release -p pdeshape --test editor_load -- --ignored
+/// --nocapture`), printing the median and p99 latency.
+#[test]
+#[ignore]
+fn klein_bottle_load_latency() {
+    let (_server, url) = serve();
+    let text = example("klein-bottle.toml").replace("resolution = [161, 65]", "resolution = [100, 100]");
+    let values: Vec<f64> = (0..16).map(|i| 0.8 + 0.05 * i as f64).collect();
+    let t = Instant::now();
+    let mut lat = load(&url, &text, "a", &values, 8, 200);
+    let wall = t.elapsed().as_secs_f64();
+    let (p50, p99) = (percentile(&mut lat, 0.5), percentile(&mut lat, 0.99));
+    println!("klein 100x100: {} requests in {wall:.1} s, median {p50:.1} ms, p99 {p99:.1} ms", lat.len());
+}
