@@ -31,9 +31,12 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     m.name = p.name.clone();
     let dom = p.surface.v_domain();
     let n = (4 * nv).max(64);
-    for c in p.conditions.iter().filter(|c| c.order == 0 && p.trim.is_none()) {
-        let pts: Vec<_> = (0..=n).map(|k| p.surface.point(c.u, dom.at(k as f64 / n as f64))).collect();
-        m.curves.push(pts);
+    // the position conditions' curves, evaluated together on the grid path (rows shared)
+    let us: Vec<f64> = p.conditions.iter().filter(|c| c.order == 0 && p.trim.is_none()).map(|c| c.u).collect();
+    if !us.is_empty() {
+        let vs: Vec<f64> = (0..=n).map(|k| dom.at(k as f64 / n as f64)).collect();
+        let g = p.surface.grid(&us, &vs);
+        m.curves.extend(g.chunks(vs.len()).map(|row| row.iter().map(|d| d[0]).collect::<Vec<_>>()));
     }
     if let Some(b) = &p.blend {
         add_continuity_fields(&mut m, p, b.blend.as_ref());
@@ -163,6 +166,23 @@ pub fn solid_context(p: &ScenePatch) -> Vec<Mesh> {
 /// Meshes of all patches, in scene order.
 pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
     scene.patches.iter().map(patch_mesh).collect()
+}
+
+/// FNV-1a (64-bit) over the `f32` bits of every position, in order: the fingerprint of a
+/// model the editor shows to its page and tests compare with the library's meshes.
+pub fn mesh_hash(meshes: &[Mesh]) -> String {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for m in meshes {
+        for p in &m.positions {
+            for x in [p.x as f32, p.y as f32, p.z as f32] {
+                for b in x.to_le_bytes() {
+                    h ^= b as u64;
+                    h = h.wrapping_mul(0x100000001b3);
+                }
+            }
+        }
+    }
+    format!("{h:016x}")
 }
 
 /// Meshes of the primary surfaces drawn in context (those with an `s_range`).

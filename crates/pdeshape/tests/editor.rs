@@ -10,38 +10,14 @@
 use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};
 use fantoccini::{Client, ClientBuilder, Locator};
 use serde_json::{Value, json};
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-struct Kill(Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+mod common;
+use common::{Kill, serve};
+use std::process::{Command, Stdio};
 
 fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
-}
-
-fn example(name: &str) -> std::path::PathBuf {
-    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
-}
-
-/// Starts `pdeshape serve SCENE --port 0` and returns it with its URL.
-fn serve(scene: &str) -> (Kill, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
-        .args(["serve", example(scene).to_str().unwrap(), "--port", "0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-    let url = line.trim().rsplit(' ').next().unwrap().to_string();
-    assert!(url.starts_with("http://127.0.0.1:"), "{line}");
-    (Kill(child), url)
 }
 
 async fn js(c: &Client, script: &str) -> Value {
@@ -95,7 +71,7 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
         eprintln!("skipped: no chromedriver (install chromium and chromium-driver; .ci/run does)");
         return;
     };
-    let (_server, url) = serve("trim-spline.toml");
+    let (_server, url) = serve(Some("trim-spline.toml"));
     let port = free_port();
     let _driver = Kill(
         Command::new(driver_bin)

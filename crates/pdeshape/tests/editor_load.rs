@@ -5,48 +5,17 @@ use pdeshape_io::model;
 use pdeshape_io::scene::{LoadOptions, Scene};
 use serde_json::{Value, json};
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
 use std::time::Instant;
 
-struct Kill(Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+mod common;
 
 fn example(name: &str) -> String {
-    std::fs::read_to_string(std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name))
-        .unwrap()
+    std::fs::read_to_string(common::example(name)).unwrap()
 }
 
-fn serve() -> (Kill, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
-        .args(["serve", "--port", "0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-    (Kill(child), line.trim().rsplit(' ').next().unwrap().to_string())
-}
-
-/// The page's fingerprint: FNV-1a over the f32 bits of every position.
+/// The page's fingerprint of the library's meshes for the scene.
 fn hash(scene: &Scene) -> String {
-    let mut h: u64 = 0xcbf29ce484222325;
-    for p in &scene.patches {
-        for q in model::patch_mesh(p).unwrap().positions {
-            for x in [q.x as f32, q.y as f32, q.z as f32] {
-                for b in x.to_le_bytes() {
-                    h ^= b as u64;
-                    h = h.wrapping_mul(0x100000001b3);
-                }
-            }
-        }
-    }
-    format!("{h:016x}")
+    model::mesh_hash(&model::patch_meshes(scene).unwrap())
 }
 
 fn header(body: &[u8]) -> Value {
@@ -107,7 +76,7 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
 
 #[test]
 fn eight_clients_get_correct_meshes() {
-    let (_server, url) = serve();
+    let (_server, url) = common::serve(None);
     let text = example("four-curve-patch.toml");
     let values: Vec<f64> = (0..10).map(|i| 0.8 + 0.1 * i as f64).collect();
     let lat = load(&url, &text, "a", &values, 8, 25);
@@ -120,7 +89,7 @@ fn eight_clients_get_correct_meshes() {
 #[test]
 #[ignore]
 fn klein_bottle_load_latency() {
-    let (_server, url) = serve();
+    let (_server, url) = common::serve(None);
     let text = example("klein-bottle.toml").replace("resolution = [161, 65]", "resolution = [100, 100]");
     let values: Vec<f64> = (0..16).map(|i| 0.8 + 0.05 * i as f64).collect();
     let t = Instant::now();

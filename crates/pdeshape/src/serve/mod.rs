@@ -236,22 +236,6 @@ async fn export_route(
     }
 }
 
-/// FNV-1a over the bits of every position: a fingerprint of the mesh for tests and the page.
-pub fn mesh_hash(meshes: &[Mesh]) -> String {
-    let mut h: u64 = 0xcbf29ce484222325;
-    for m in meshes {
-        for p in &m.positions {
-            for x in [p.x as f32, p.y as f32, p.z as f32] {
-                for b in x.to_le_bytes() {
-                    h ^= b as u64;
-                    h = h.wrapping_mul(0x100000001b3);
-                }
-            }
-        }
-    }
-    format!("{h:016x}")
-}
-
 /// The binary answer: `u32` header length, JSON header (padded to 4 bytes), buffers.
 fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
     let mut buf: Vec<u8> = Vec::new();
@@ -308,7 +292,7 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
                 v
             })
             .collect();
-        fields.extend(curvature_field(&mut buf, m));
+        fields.extend(curvature_field(&mut buf, m, &tris));
         let trim = p.trim.as_ref().map(|t| {
             let g = &t.grid;
             let ring0: Vec<[f64; 2]> = (0..=g.columns).map(|j| g.points[g.index(0, j)]).collect();
@@ -351,7 +335,7 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
         "view": {"azimuth": s.scene.render.azimuth, "elevation": s.scene.render.elevation},
         "patches": patches,
         "editables": edit::editables(&s.text),
-        "hash": mesh_hash(&s.meshes),
+        "hash": model::mesh_hash(&s.meshes),
         "solve_ms": s.solve_ms,
         "diagnostics": if diagnostics { model::scene_diagnostics(&s.scene) } else { Value::Null },
     });
@@ -369,14 +353,14 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
 /// Mean curvature from the mesh normals (a per-vertex field for the colour map):
 /// `H ≈ ½ Σ (n_j − n_i)·(p_j − p_i)/|p_j − p_i|²` over the mesh neighbours (a display
 /// estimate; the exact field is `check`'s business).
-fn curvature_field(buf: &mut Vec<u8>, m: &Mesh) -> Option<Value> {
+fn curvature_field(buf: &mut Vec<u8>, m: &Mesh, tris: &[[u32; 3]]) -> Option<Value> {
     if m.normals.len() != m.positions.len() || m.positions.is_empty() {
         return None;
     }
     let n = m.positions.len();
     let mut acc = vec![0.0f64; n];
     let mut cnt = vec![0u32; n];
-    for t in m.all_triangles() {
+    for t in tris {
         for k in 0..3 {
             let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
             let d = m.positions[b] - m.positions[a];

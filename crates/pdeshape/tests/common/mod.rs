@@ -1,0 +1,37 @@
+//! Helpers shared by the editor tests: a `pdeshape serve` child that dies with the test.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+
+/// Kills and reaps the child when dropped (also when a test panics).
+pub struct Kill(pub Child);
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The path of a scene file under `examples/`.
+pub fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
+}
+
+/// Starts `pdeshape serve [SCENE] --port 0` and returns it with the URL it printed.
+pub fn serve(scene: Option<&str>) -> (Kill, String) {
+    let mut args: Vec<String> = scene.map(|s| example(s).to_string_lossy().into_owned()).into_iter().collect();
+    args.extend(["--port".into(), "0".into()]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .arg("serve")
+        .args(&args)
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("pdeshape serve starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+    let url = line.trim().rsplit(' ').next().unwrap_or_default().to_string();
+    assert!(url.starts_with("http://127.0.0.1:"), "serve printed {line:?}");
+    (Kill(child), url)
+}
