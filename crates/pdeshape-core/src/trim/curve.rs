@@ -97,19 +97,44 @@ impl TrimCurve {
         }
     }
 
-    /// The closest point of the curve to `p`: `(t, distance)`, by a search over a fine
-    /// polygonisation refined by Newton's method on `(C(t) − p)·C'(t) = 0` (exact
-    /// derivatives).
+    /// The closest point of the curve to `p`: `(t, distance)`. A polygon is measured
+    /// exactly, edge by edge (it is linear in `t` between its vertices); a smooth curve by
+    /// a search over a fine polygonisation refined by Newton's method on
+    /// `(C(t) − p)·C'(t) = 0` (exact derivatives), never returning a worse point than the
+    /// search found.
     pub fn closest(&self, p: Uv) -> (f64, f64) {
         let d2 = |q: Uv| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
-        let (mut t, _) = self
+        if let TrimCurve::Spline(b) = self
+            && b.degree() == 1
+        {
+            let v = self.polygonize(1);
+            let n = v.len();
+            return (0..n)
+                .map(|i| {
+                    let (a, c) = (v[i].1, v[(i + 1) % n].1);
+                    let e = sub(c, a);
+                    let l2 = e[0] * e[0] + e[1] * e[1];
+                    let r = sub(p, a);
+                    let s = if l2 > 0.0 { ((r[0] * e[0] + r[1] * e[1]) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                    let q = [a[0] + s * e[0], a[1] + s * e[1]];
+                    (v[i].0 + s * TAU / n as f64, d2(q).sqrt())
+                })
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .expect("a polygon has vertices");
+        }
+        let (t0, q0) = self
             .polygonize(64)
             .into_iter()
             .min_by(|a, b| d2(a.1).total_cmp(&d2(b.1)))
             .expect("a polygonisation is never empty");
+        let mut best = (t0, d2(q0));
+        let mut t = t0;
         for _ in 0..30 {
             let d = self.derivatives(t, 2);
             let r = sub(d[0], p);
+            if d2(d[0]) < best.1 {
+                best = (t, d2(d[0]));
+            }
             let f = r[0] * d[1][0] + r[1] * d[1][1];
             let fp = d[1][0] * d[1][0] + d[1][1] * d[1][1] + r[0] * d[2][0] + r[1] * d[2][1];
             if fp <= 0.0 {
@@ -121,7 +146,34 @@ impl TrimCurve {
                 break;
             }
         }
-        (t, d2(self.point(t)).sqrt())
+        if d2(self.point(t)) < best.1 {
+            best = (t, d2(self.point(t)));
+        }
+        // Newton stalls where the speed vanishes (a corner from repeated control points):
+        // a golden-section search between the neighbouring samples finds the minimum there.
+        let h = TAU / (64 * self.knots().len()) as f64; // the spacing of `polygonize(64)`
+        let (mut a, mut b) = (t0 - h, t0 + h);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let f = |t: f64| d2(self.point(t));
+        let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
+        let (mut f1, mut f2) = (f(x1), f(x2));
+        for _ in 0..80 {
+            if f1 < f2 {
+                (b, x2, f2) = (x2, x1, f1);
+                x1 = b - g * (b - a);
+                f1 = f(x1);
+            } else {
+                (a, x1, f1) = (x1, x2, f2);
+                x2 = a + g * (b - a);
+                f2 = f(x2);
+            }
+        }
+        for (t, v) in [(x1, f1), (x2, f2)] {
+            if v < best.1 {
+                best = (t, v);
+            }
+        }
+        (best.0.rem_euclid(TAU), best.1.sqrt())
     }
 
     /// Parameter values at which the curve may have a kink or a knot (polygon vertices,

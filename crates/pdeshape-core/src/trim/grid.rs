@@ -188,6 +188,8 @@ pub fn trim_grid(map: &LaplaceMap, o: &TrimOptions) -> Result<TrimGrid, TrimErro
         inside = if folds == 0 { count_inside(map, &p, rings, cols) } else { inside.max(1) };
     }
     if folds > 0 || inside > 0 {
+        // while folds remained, `inside` was not recounted: count it for the error
+        let inside = if folds > 0 { count_inside(map, &p, rings, cols) } else { inside };
         return Err(TrimError::CannotRepair { folds, inside, sweeps });
     }
     let mut report = if o.verify {

@@ -80,6 +80,17 @@ pub enum TrimError {
         /// Curve name.
         curve: String,
     },
+    /// A curve has a cusp or turns back along itself.
+    #[error(
+        "trim curve `{curve}` has a cusp or turns back on itself near (u, v) = ({:.6}, {:.6}); move the control points apart",
+        at[0], at[1]
+    )]
+    Cusp {
+        /// Curve name.
+        curve: String,
+        /// Near here.
+        at: Uv,
+    },
     /// A curve crosses itself.
     #[error("trim curve `{curve}` intersects itself near (u, v) = ({:.6}, {:.6})", at[0], at[1])]
     SelfIntersection {

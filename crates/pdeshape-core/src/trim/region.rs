@@ -3,7 +3,7 @@
 //! bridge segments traversed both ways (paper 003, Fig. 7).
 
 use super::TrimError;
-use super::curve::{TrimCurve, Uv, cross, distance_to_segment, inside_polygon, segments_intersect, signed_area2};
+use super::curve::{TrimCurve, Uv, cross, distance_to_segment, inside_polygon, segments_intersect, signed_area2, sub};
 use std::f64::consts::TAU;
 
 /// The parameter rectangle `[u₀, u₁] × [v₀, v₁]`.
@@ -83,7 +83,8 @@ impl TrimRegion {
     /// Validates the curves against the domain and each other, and joins them.
     ///
     /// Errors: a curve that is not finite, leaves the (open) domain, is degenerate
-    /// (zero area), crosses itself, crosses or lies inside another curve; bridges that
+    /// (zero area), has a cusp or doubles back on itself, crosses itself, crosses or lies
+    /// inside another curve; bridges that
     /// would cross a curve or another bridge.
     pub fn new(domain: Rect, curves: Vec<(String, TrimCurve)>) -> Result<Self, TrimError> {
         if curves.is_empty() {
@@ -106,6 +107,10 @@ impl TrimRegion {
                 return Err(TrimError::LeavesDomain { curve: name.clone(), t: *t, at: *p, domain });
             }
             let poly: Vec<Uv> = pts.iter().map(|x| x.1).collect();
+            let corners_allowed = matches!(c, TrimCurve::Spline(b) if b.degree() == 1);
+            if let Some(at) = reversal(&poly, corners_allowed) {
+                return Err(TrimError::Cusp { curve: name.clone(), at });
+            }
             if let Some(at) = self_intersection(&poly) {
                 return Err(TrimError::SelfIntersection { curve: name.clone(), at });
             }
@@ -350,6 +355,24 @@ fn centroid(p: &[Uv]) -> Uv {
 }
 
 /// The first crossing between non-adjacent edges of a closed polygon.
+/// A point where the closed polygonisation `p` turns back on itself: consecutive
+/// (non-zero) edges pointing against each other. For a smooth curve sampled finely that is
+/// a cusp (its tangent reverses within one sample); for a polygon (`corners_allowed`) only a
+/// vertex where it doubles back along its own edge (a turn of 180°) counts.
+fn reversal(p: &[Uv], corners_allowed: bool) -> Option<Uv> {
+    let n = p.len();
+    let edges: Vec<(Uv, Uv)> =
+        (0..n).map(|i| (sub(p[(i + 1) % n], p[i]), p[(i + 1) % n])).filter(|(e, _)| *e != [0.0, 0.0]).collect();
+    let m = edges.len();
+    (0..m).find_map(|i| {
+        let ((a, at), (b, _)) = (edges[i], edges[(i + 1) % m]);
+        let dot = a[0] * b[0] + a[1] * b[1];
+        let len = (a[0].hypot(a[1])) * (b[0].hypot(b[1]));
+        let reverses = dot < 0.0 && (!corners_allowed || cross(a, b).abs() <= 1e-9 * len);
+        reverses.then_some(at)
+    })
+}
+
 fn self_intersection(p: &[Uv]) -> Option<Uv> {
     let n = p.len();
     let bbox = |i: usize| {
