@@ -20,6 +20,7 @@ pub mod blend;
 pub mod data;
 pub mod expr;
 pub mod jet;
+pub mod limits;
 pub mod linalg;
 pub mod mesh;
 pub mod ode;

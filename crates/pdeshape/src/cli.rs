@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
+use pdeshape_core::limits::Limits;
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::scene::{LoadOptions, Scene};
@@ -17,6 +18,11 @@ pub struct Cli {
     /// Print nothing but errors (no progress bars).
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// Raise or lower a cap on what a scene may ask for: order (PDE order, default 64),
+    /// modes (Fourier modes, sine terms, bubbles, solid terms; 512), collocation (points
+    /// of one solve; 4000000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
+    #[arg(long = "limit", global = true, value_name = "CAP=VALUE")]
+    limit: Vec<String>,
     #[command(subcommand)]
     command: Command,
 }
@@ -140,6 +146,14 @@ pub fn run() -> i32 {
             return code;
         }
     };
+    let mut limits = Limits::default();
+    for l in &cli.limit {
+        if let Err(e) = limits.apply(l) {
+            eprintln!("error: --limit {e}");
+            return 2;
+        }
+    }
+    let _ = LIMITS.set(limits);
     match execute(cli) {
         Ok(()) => 0,
         Err(e) => {
@@ -147,6 +161,13 @@ pub fn run() -> i32 {
             1
         }
     }
+}
+
+static LIMITS: std::sync::OnceLock<Limits> = std::sync::OnceLock::new();
+
+/// The caps in force for this process (`--limit`, else the defaults).
+pub fn limits() -> Limits {
+    LIMITS.get().copied().unwrap_or_default()
 }
 
 fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
@@ -176,7 +197,7 @@ pub fn load_opts(path: &Path, set: &[String], solver: Option<&str>, terms: Optio
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {}", path.display()))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string), terms };
+    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string), terms, limits: limits() };
     Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
 }
 

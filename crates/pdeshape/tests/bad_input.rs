@@ -20,11 +20,24 @@ fn good() -> String {
 
 /// Runs `pdeshape build scene -o out.obj` and checks the failure.
 fn fails(scene: &str, expect: &[&str]) {
+    fails_with(scene, &[], expect)
+}
+
+/// [`fails`] with extra arguments.
+fn fails_with(scene: &str, args: &[&str], expect: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, scene).unwrap();
     let out = dir.path().join("out.obj");
-    let a = Command::cargo_bin("pdeshape").unwrap().arg("build").arg(&path).arg("-o").arg(&out).arg("-q").assert();
+    let a = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .arg("build")
+        .arg(&path)
+        .arg("-o")
+        .arg(&out)
+        .arg("-q")
+        .args(args)
+        .assert();
     let o = a.get_output();
     let code = o.status.code().expect("exited normally, not by a signal");
     let err = String::from_utf8_lossy(&o.stderr);
@@ -177,7 +190,7 @@ fn resolution_zero() {
 fn resolution_huge() {
     fails(
         &good().replace("kind = \"hermite\"", "kind = \"hermite\"\nresolution = [1000000000, 10]"),
-        &["patches.p.resolution", "exceeds the limit"],
+        &["patches.p.resolution", "over the `vertices` cap of 4000000", "--limit vertices=10000000000"],
     );
 }
 
@@ -372,4 +385,34 @@ fn blend_exact_solver_on_data_it_cannot_take() {
          [patches.p]\nkind = \"blend\"\norders = [2, 2, 2]\nsolver = \"exact\"\n\
          conditions = [{ u = 0, curve = \"c0\" }, { u = 1, curve = \"c1\" }]\n";
     fails(s, &["patches.p", "exact solver needs eigenfunctions", "component z"]);
+}
+
+/// The same scene as a PDE patch with `extra` keys.
+fn pde(extra: &str) -> String {
+    good().replace("kind = \"hermite\"", &format!("kind = \"pde\"\n{extra}"))
+}
+
+#[test]
+fn caps_name_themselves_and_how_to_raise_them() {
+    fails(&pde("modes = 600"), &["patches.p.modes", "over the `modes` cap of 512", "--limit modes=600"]);
+    fails_with(&pde("modes = 4"), &["--limit", "modes=3"], &["`modes` cap of 3", "--limit modes=4"]);
+    fails_with(&pde(""), &["--limit", "order=1"], &["patches.p.conditions", "the PDE order", "`order` cap of 1"]);
+    fails_with(
+        &pde("resolution = [400, 400]"),
+        &["--limit", "memory=1"],
+        &["patches.p", "estimated memory", "`memory` cap of 1 MiB", "--limit memory="],
+    );
+    fails_with(&good(), &["--limit", "colour=3"], &["unknown cap `colour`", "order, modes, collocation"]);
+    fails_with(&good(), &["--limit", "order=many"], &["not a whole number"]);
+}
+
+#[test]
+fn a_raised_cap_lets_the_scene_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, pde("modes = 600\nresolution = [5, 9]")).unwrap();
+    let out = dir.path().join("out.obj");
+    let mut c = Command::cargo_bin("pdeshape").unwrap();
+    c.arg("build").arg(&path).arg("-o").arg(&out).args(["-q", "--limit", "modes=600"]).assert().success();
+    assert!(out.exists());
 }

@@ -155,9 +155,6 @@ impl SpectralPatch {
         if !(opts.a.is_finite() && opts.a > 0.0) {
             return Err(SpectralError::Options(format!("the shape parameter a = {} must be positive", opts.a)));
         }
-        if opts.modes > 512 {
-            return Err(SpectralError::Options(format!("{} Fourier modes exceed the limit of 512", opts.modes)));
-        }
         let n = conds.len() / 2;
         let omega = opts.omega.unwrap_or(opts.a * (opts.modes + 1) as f64);
         if !(omega.is_finite() && omega > 0.0) {

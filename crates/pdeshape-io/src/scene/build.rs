@@ -10,6 +10,7 @@ use pdeshape_core::blend::{
 };
 use pdeshape_core::data::{BSplineCurve, Combination, ExprField, FieldRef, PointField, Trimline, curve_derivative};
 use pdeshape_core::expr::{BinOp, Expr, ExprError, Func, Node};
+use pdeshape_core::limits::{Cap, Limits};
 use pdeshape_core::patch::{Condition, HermitePatch, VDomain};
 use pdeshape_core::spectral::{SpectralOptions, SpectralPatch};
 use std::collections::HashMap;
@@ -20,9 +21,6 @@ use toml::Spanned;
 /// Names that parameters, curves and surfaces may not take: variables, constants and
 /// function names of the expression language.
 pub const RESERVED: &[&str] = &["u", "v", "w", "s", "t", "pi", "e", "log"];
-
-/// Largest number of mesh vertices one patch may ask for.
-pub const MAX_VERTICES: usize = 4_000_000;
 
 /// Output formats a scene may list.
 pub const FORMATS: &[&str] = &["obj", "ply", "stl", "glb", "vtu", "png"];
@@ -36,6 +34,8 @@ pub(super) struct Ctx<'a> {
     solver: Option<Solver>,
     /// Override of the sine-term count of dynamic blends.
     terms: Option<usize>,
+    /// Caps on sizes.
+    pub(super) limits: Limits,
 }
 
 pub(super) fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
@@ -146,6 +146,21 @@ impl Ctx<'_> {
         Ok(v)
     }
 
+    /// An integer `≥ lo` within `cap`.
+    pub(super) fn capped(&self, x: &Spanned<i64>, lo: i64, cap: Cap, key: &str) -> R<usize> {
+        let v = *x.get_ref();
+        if v < lo {
+            return Err(self.err(span(x), key, format!("{v} is too small (expected at least {lo})")));
+        }
+        self.cap(cap, v as u128, span(x), key, &format!("`{key}`"))?;
+        Ok(v as usize)
+    }
+
+    /// `value` checked against `cap`; the error names the place, the cap and how to raise it.
+    pub(super) fn cap(&self, cap: Cap, value: u128, sp: Option<Range<usize>>, key: &str, what: &str) -> R<()> {
+        self.limits.check(cap, value, what).map_err(|e| self.err(sp, key, e.to_string()))
+    }
+
     fn range(&self, x: &Spanned<[NumOrExpr; 2]>, key: &str) -> R<(f64, f64)> {
         let a = self.num(&x.get_ref()[0], span(x), key)?;
         let b = self.num(&x.get_ref()[1], span(x), key)?;
@@ -190,13 +205,7 @@ impl Ctx<'_> {
                 format!("resolution [{a}, {b}] is too small (at least 2 × 2 vertices)"),
             ));
         }
-        if (a as u128) * (b as u128) > MAX_VERTICES as u128 {
-            return Err(self.err(
-                span(x),
-                key,
-                format!("resolution [{a}, {b}] exceeds the limit of {MAX_VERTICES} vertices per patch"),
-            ));
-        }
+        self.cap(Cap::Vertices, a as u128 * b as u128, span(x), key, &format!("resolution [{a}, {b}] (vertices)"))?;
         Ok((a as usize, b as usize))
     }
 }
@@ -579,7 +588,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
             src.error(None, "--solver", format!("unknown solver `{w}` (known: auto, exact, collocation)"))
         })?),
     };
-    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver, terms: opts.terms };
+    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver, terms: opts.terms, limits: opts.limits };
     let mut taken: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.parameters {
         check_name(&src, n, span(p), &format!("parameters.{n}"), &mut taken)?;
@@ -615,8 +624,12 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
     let curves: IndexMap<String, FieldRef> = raw.curves.keys().map(|n| (n.clone(), cb.done[n].clone())).collect();
 
     let mut patches = Vec::new();
+    let mut bytes = 0u128;
     for (pname, p) in &raw.patches {
         let built = build_patch(&ctx, pname, p, &curves, &surfaces, &patches)?;
+        bytes += built.memory_estimate();
+        let mib = bytes.div_ceil(1 << 20);
+        ctx.cap(Cap::Memory, mib, span(p), &format!("patches.{pname}"), "the estimated memory of the meshes")?;
         patches.push(built);
     }
 
@@ -926,11 +939,13 @@ fn build_patch(
                 None => 1.0,
             };
             let modes = match &rp.modes {
-                Some(m) => ctx.int(m, 0, 512, &format!("{key}.modes"))? as usize,
+                Some(m) => ctx.capped(m, 0, Cap::Modes, &format!("{key}.modes"))?,
                 None => 6,
             };
             let omega =
                 rp.omega.as_ref().map(|x| ctx.num(x.get_ref(), span(x), &format!("{key}.omega"))).transpose()?;
+            let what = format!("the PDE order (conditions of `{key}`)");
+            ctx.cap(Cap::Order, conditions.len() as u128, conds_span.clone(), &format!("{key}.conditions"), &what)?;
             let sp = SpectralPatch::new(&conditions, domain, SpectralOptions { a, modes, omega })
                 .map_err(|e| ctx.err(conds_span.clone(), format!("{key}.conditions"), e.to_string()))?;
             let sp = Arc::new(sp);
@@ -1027,22 +1042,25 @@ fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<Sc
     }
     if let Some(l) = &rp.lmn {
         let [a, b, c] = *l.get_ref();
-        if [a, b, c].iter().any(|x| !(1..=40).contains(x)) {
-            return Err(ctx.err(
-                span(l),
-                format!("{key}.lmn"),
-                format!("[{a}, {b}, {c}] is out of range (1 … 40 each)"),
-            ));
+        if [a, b, c].iter().any(|x| *x < 1) {
+            return Err(ctx.err(span(l), format!("{key}.lmn"), format!("[{a}, {b}, {c}]: every count must be ≥ 1")));
         }
+        let k = format!("{key}.lmn");
+        ctx.cap(Cap::Modes, a.max(b).max(c) as u128, span(l), &k, &format!("the largest of [{a}, {b}, {c}] (`{k}`)"))?;
+        // the Gauss grid of the least-squares fit (see `SolidBlend::new`)
+        let points = (3 * a as u128 + 24) * (3 * b as u128 + 24) * (2 * c as u128 + 24);
+        ctx.cap(Cap::Collocation, points, span(l), &k, &format!("the quadrature grid of [{a}, {b}, {c}]"))?;
         opts.terms = (a as usize, b as usize, c as usize);
     }
     let cells = match &rp.cells {
         None => (17, 33, 17),
         Some(c) => {
             let [a, b, d] = *c.get_ref();
-            if [a, b, d].iter().any(|x| !(2..=400).contains(x)) || (a * b * d) as usize > MAX_VERTICES {
-                return Err(ctx.err(span(c), format!("{key}.cells"), format!("[{a}, {b}, {d}] is out of range")));
+            if [a, b, d].iter().any(|x| *x < 2) {
+                return Err(ctx.err(span(c), format!("{key}.cells"), format!("[{a}, {b}, {d}]: at least 2 each")));
             }
+            let cells = a as u128 * b as u128 * d as u128;
+            ctx.cap(Cap::Vertices, cells, span(c), &format!("{key}.cells"), &format!("cells [{a}, {b}, {d}]"))?;
             (a as usize, b as usize, d as usize)
         }
     };
@@ -1105,20 +1123,23 @@ fn build_dynamic(
         opts.solver = sv;
     }
     if let Some(k) = &rp.terms {
-        opts.terms = ctx.int(k, 1, 60, &format!("{key}.terms"))? as usize;
+        opts.terms = ctx.capped(k, 1, Cap::Modes, &format!("{key}.terms"))?;
     }
     if let Some(k) = ctx.terms {
+        ctx.cap(Cap::Modes, k as u128, None, "--terms", "the sine terms K")?;
         opts.terms = k;
     }
     if let Some(c) = &rp.collocation {
         let [l, m] = *c.get_ref();
-        if !(2..=400).contains(&l) || !(1..=400).contains(&m) {
+        if l < 2 || m < 1 {
             return Err(ctx.err(
                 span(c),
                 format!("{key}.collocation"),
-                format!("[{l}, {m}] is out of range (2 … 400)"),
+                format!("[{l}, {m}] is too small (at least [2, 1])"),
             ));
         }
+        let k = format!("{key}.collocation");
+        ctx.cap(Cap::Collocation, l as u128 * m as u128, span(c), &k, &format!("the collocation grid [{l}, {m}]"))?;
         opts.collocation = (l as usize, m as usize);
     }
     opts.joint = rp.joint.as_ref().map(|j| *j.get_ref()).unwrap_or(false);
@@ -1191,17 +1212,19 @@ fn build_blend(
         options.solver = sv;
     }
     if let Some(b) = &rp.bubbles {
-        options.bubbles = ctx.int(b, 1, 40, &format!("{key}.bubbles"))? as usize;
+        options.bubbles = ctx.capped(b, 1, Cap::Modes, &format!("{key}.bubbles"))?;
     }
     if let Some(c) = &rp.collocation {
         let [l, q] = *c.get_ref();
-        if !(1..=400).contains(&l) || !(1..=400).contains(&q) {
+        if l < 1 || q < 1 {
             return Err(ctx.err(
                 span(c),
                 format!("{key}.collocation"),
-                format!("[{l}, {q}] is out of range (1 … 400)"),
+                format!("[{l}, {q}] is too small (at least 1 each)"),
             ));
         }
+        let k = format!("{key}.collocation");
+        ctx.cap(Cap::Collocation, l as u128 * q as u128, span(c), &k, &format!("the collocation grid [{l}, {q}]"))?;
         options.collocation = Some((l as usize, q as usize));
     }
     if let Some(list) = &rp.basis {
@@ -1221,7 +1244,7 @@ fn build_sections(
     key: &str,
 ) -> R<(Vec<Condition>, Option<super::SectionFamily>)> {
     let rs = sec.get_ref();
-    let count = ctx.int(&rs.count, 2, 200, &format!("{key}.count"))? as usize;
+    let count = ctx.capped(&rs.count, 2, Cap::Order, &format!("{key}.count"))?;
     let us: Vec<f64> = match (&rs.u, &rs.spacing) {
         (Some(_), Some(sp)) => {
             return Err(ctx.err(span(sp), format!("{key}.spacing"), "give either `spacing` or explicit `u`, not both"));

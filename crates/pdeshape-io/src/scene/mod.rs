@@ -13,9 +13,8 @@ mod error;
 mod raw;
 mod trim;
 
-pub use build::{MAX_VERTICES, RESERVED};
+pub use build::RESERVED;
 pub use error::{SceneError, Source};
-pub use trim::MAX_TRIM_VERTICES;
 
 use indexmap::IndexMap;
 use pdeshape_core::data::FieldRef;
@@ -66,6 +65,8 @@ pub struct LoadOptions {
     pub solver: Option<String>,
     /// Sine terms `K` for dynamic blends (overrides the scene).
     pub terms: Option<usize>,
+    /// Caps on order, modes, collocation size, resolution and memory.
+    pub limits: pdeshape_core::limits::Limits,
 }
 
 /// What a patch is.
@@ -127,6 +128,27 @@ pub struct ScenePatch {
 }
 
 /// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid. The map
+impl ScenePatch {
+    /// Estimated bytes of this patch's meshes (what [`crate::model::patch_mesh`] and the
+    /// exporters hold): the surface grid or trimmed grid with its per-vertex fields, every
+    /// frame of a dynamic blend, the hexahedral cells of a solid.
+    pub fn memory_estimate(&self) -> u128 {
+        use pdeshape_core::limits::surface_mesh_bytes;
+        if let Some(sd) = &self.solid {
+            let (a, b, c) = sd.cells;
+            let cells = a as u128 * b as u128 * c as u128;
+            return cells * (24 + 8 * 4 + 32) + surface_mesh_bytes(2 * (a * b + b * c + a * c), 0);
+        }
+        let vertices = match &self.trim {
+            Some(t) => t.grid.rings * (t.grid.columns + 1),
+            None => self.resolution.0 * self.resolution.1,
+        };
+        let fields = if self.blend.is_some() { 5 } else { 0 };
+        let frames = self.dynamic.as_ref().map_or(0, |d| d.frames as u128);
+        surface_mesh_bytes(vertices, fields) + frames * vertices as u128 * 48
+    }
+}
+
 /// is solved in the metric-scaled plane `(u, k v)` (see `scale`).
 #[derive(Clone, Debug)]
 pub struct TrimSetup {

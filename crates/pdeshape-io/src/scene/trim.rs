@@ -10,9 +10,6 @@ use pdeshape_core::trim::{CurveOnSurface, LaplaceMap, Rect, TrimCurve, TrimOptio
 use std::sync::Arc;
 use toml::Spanned;
 
-/// Largest trim grid (rings × columns).
-pub const MAX_TRIM_VERTICES: usize = 1_000_000;
-
 fn uv(ctx: &Ctx, p: &[NumOrExpr; 2], sp: Option<std::ops::Range<usize>>, key: &str) -> R<[f64; 2]> {
     Ok([ctx.num(&p[0], sp.clone(), key)?, ctx.num(&p[1], sp, key)?])
 }
@@ -63,11 +60,11 @@ pub(super) fn build_trim(
     let key = format!("{key}.trim");
     let rt = raw.get_ref();
     let (rings, columns) = ctx.resolution(&rt.resolution, (20, 64), &format!("{key}.resolution"))?;
-    if rings * columns > MAX_TRIM_VERTICES || columns < 8 {
+    if columns < 8 {
         return Err(ctx.err(
             span(raw),
             format!("{key}.resolution"),
-            format!("[{rings}, {columns}] is out of range (at least 8 columns, at most {MAX_TRIM_VERTICES} vertices)"),
+            format!("[{rings}, {columns}] has too few columns (at least 8)"),
         ));
     }
     let modes = match &rt.modes {

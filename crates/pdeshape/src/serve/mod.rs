@@ -85,7 +85,12 @@ pub fn run(o: ServeOptions) -> Result<()> {
                 std::fs::read_to_string(p).with_context(|| format!("cannot read the scene file {}", p.display()))?;
             let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
             // refuse a broken scene at start, with the scene error
-            Scene::parse_with(&text, &p.display().to_string(), &name, &LoadOptions::default())?;
+            Scene::parse_with(
+                &text,
+                &p.display().to_string(),
+                &name,
+                &LoadOptions { limits: crate::cli::limits(), ..Default::default() },
+            )?;
             Some((name, text))
         }
         None => None,
@@ -168,7 +173,7 @@ struct Solved {
 pub fn solve(req: &ModelRequest) -> Result<(Scene, String, Vec<Mesh>), String> {
     let text = edit::apply(&req.text, &req.edits)?;
     let name = req.name.clone().unwrap_or_else(|| "scene".into());
-    let opts = LoadOptions { params: req.params.clone(), ..Default::default() };
+    let opts = LoadOptions { params: req.params.clone(), limits: crate::cli::limits(), ..Default::default() };
     let scene = Scene::parse_with(&text, &format!("{name}.toml"), &name, &opts).map_err(|e| e.to_string())?;
     let estimate: usize = scene.patches.iter().map(|p| p.resolution.0 * p.resolution.1).sum();
     if estimate > MAX_VERTICES {
