@@ -71,7 +71,7 @@ pub struct LimitError {
     pub limit: usize,
 }
 
-/// The caps in force. Defaults: order 64, modes 512, collocation 4 000 000 points,
+/// The caps in force. Defaults: order 64, modes 512, collocation 250 000 points,
 /// vertices 4 000 000 per patch, memory 4096 MiB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
@@ -89,7 +89,7 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { order: 64, modes: 512, collocation: 4_000_000, vertices: 4_000_000, memory: 4096 }
+        Limits { order: 64, modes: 512, collocation: 250_000, vertices: 4_000_000, memory: 4096 }
     }
 }
 

@@ -20,7 +20,7 @@ pub struct Cli {
     quiet: bool,
     /// Raise or lower a cap on what a scene may ask for: order (PDE order, default 64),
     /// modes (Fourier modes, sine terms, bubbles, solid terms; 512), collocation (points
-    /// of one solve; 4000000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
+    /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
     #[arg(long = "limit", global = true, value_name = "CAP=VALUE")]
     limit: Vec<String>,
     #[command(subcommand)]
