@@ -219,18 +219,22 @@ fn curve_on_surface_has_exact_derivatives() {
     assert!((j.derivative([2, 0, 0]).x - ddu).abs() < 1e-14);
 }
 
-/// A closed B-spline whose control points lie at radius `r(θ)` about `c`.
-fn star(c: Uv, radii: &[f64]) -> TrimCurve {
+/// Points at radius `r(θ_k)`, `θ_k = 2πk/n`, about `c`.
+fn star_points(c: Uv, radii: &[f64]) -> Vec<Uv> {
     let n = radii.len();
-    let pts: Vec<Uv> = radii
+    radii
         .iter()
         .enumerate()
         .map(|(k, r)| {
             let th = TAU * k as f64 / n as f64;
             [c[0] + r * th.cos(), c[1] + r * th.sin()]
         })
-        .collect();
-    TrimCurve::bspline(&pts).unwrap()
+        .collect()
+}
+
+/// A closed B-spline whose control points lie at radius `r(θ)` about `c`.
+fn star(c: Uv, radii: &[f64]) -> TrimCurve {
+    TrimCurve::bspline(&star_points(c, radii)).unwrap()
 }
 
 proptest! {
@@ -285,19 +289,7 @@ proptest! {
 fn dented(c: Uv, outer: f64, ratio: f64, lobes: usize, jitter: &[f64], polygon: bool) -> TrimCurve {
     let n = 2 * lobes;
     let radii: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { outer } else { outer * ratio } * jitter[k % 12]).collect();
-    if polygon {
-        let pts: Vec<Uv> = radii
-            .iter()
-            .enumerate()
-            .map(|(k, r)| {
-                let th = TAU * k as f64 / n as f64;
-                [c[0] + r * th.cos(), c[1] + r * th.sin()]
-            })
-            .collect();
-        TrimCurve::polygon(&pts).unwrap()
-    } else {
-        star(c, &radii)
-    }
+    if polygon { TrimCurve::polygon(&star_points(c, &radii)).unwrap() } else { star(c, &radii) }
 }
 
 /// Found by the trim fuzz target: control points that make the spline run down a line and
