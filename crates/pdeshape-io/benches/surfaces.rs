@@ -3,7 +3,6 @@
 //! paper 002 eq. 19 (closed form and K = 5) at 100 × 100; the solid blend of paper 000
 //! example 2 (solve at L = M = N = 6, evaluation at 64³).
 //! Run: cargo bench -p pdeshape-io --bench surfaces
-
 use criterion::{Criterion, criterion_group, criterion_main};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
@@ -11,6 +10,10 @@ use pdeshape_core::solid::{SolidBlend, SolidOptions, Trial};
 use pdeshape_core::trim::{LaplaceMap, TrimOptions, trim_grid};
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
+
+/// The allocator of the `pdeshape` binary, so that timings match it.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn load(name: &str) -> Scene {
     Scene::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).expect("example loads")

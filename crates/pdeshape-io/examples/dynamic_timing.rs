@@ -6,6 +6,10 @@ use pdeshape_core::patch::Surface;
 use pdeshape_io::scene::Scene;
 use pdeshape_io::tables::{on_one_thread, time};
 
+/// The allocator of the `pdeshape` binary, so that timings match it.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let scene = Scene::load(&root.join("dynamic-elliptic-cylinders.toml")).unwrap();

@@ -4,6 +4,10 @@ use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_io::scene::Scene;
 use std::time::Instant;
 
+/// The allocator of the `pdeshape` binary, so that timings match it.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]

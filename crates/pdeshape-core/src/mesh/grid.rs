@@ -44,39 +44,40 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     assert!(o.nu >= 2 && o.nv >= 2, "a grid mesh needs at least 2 × 2 vertices");
     let (us, vs) = grid_params(s, o);
     let flat = s.grid(&us, &vs);
-    let rows: Vec<&[[Vec3; 4]]> = flat.chunks(o.nv).collect();
     let n = o.nu * o.nv;
-    let mut positions = Vec::with_capacity(n);
-    let mut normals = Vec::with_capacity(n);
-    let mut uvs = Vec::with_capacity(n);
-    let mut scales: Vec<f64> = flat.iter().map(|d| d[1].norm() * d[2].norm()).collect();
+    // reference size of |X_u||X_v| for the degeneracy test: the median over at most
+    // 4097 evenly strided vertices
+    let stride = (n / 4096).max(1);
+    let mut scales: Vec<f64> = flat.iter().step_by(stride).map(|d| d[1].norm() * d[2].norm()).collect();
     let mid = scales.len() / 2;
     let reference = scales.select_nth_unstable_by(mid, f64::total_cmp).1.max(f64::MIN_POSITIVE);
+    if let Some(k) = flat.par_iter().position_first(|d| !d[0].is_finite()) {
+        return Err(format!("the patch is not finite at (u, v) = ({}, {})", us[k / o.nv], vs[k % o.nv]));
+    }
     let dom = s.v_domain();
-    let mut missing = Vec::new();
-    for (i, row) in rows.iter().enumerate() {
-        for (j, d) in row.iter().enumerate() {
-            let [p, pu, pv, puv] = *d;
-            if !p.is_finite() {
-                return Err(format!("the patch is not finite at (u, v) = ({}, {})", us[i], vs[j]));
-            }
+    let u_mid = 0.5 * (o.u_range.0 + o.u_range.1);
+    let v_mid = 0.5 * (dom.start + dom.end);
+    // normals (NaN marks a vertex where even the limit vanishes), in parallel by rows
+    let mut normals = vec![Vec3::ZERO; n];
+    normals.par_chunks_mut(o.nv).zip(flat.par_chunks(o.nv)).enumerate().for_each(|(i, (dst, row))| {
+        for (j, (nm, d)) in dst.iter_mut().zip(row).enumerate() {
+            let [_, pu, pv, puv] = *d;
             let mut nrm = pu.cross(pv);
             if nrm.norm() <= 1e-9 * reference {
-                let side_u = if us[i] < 0.5 * (o.u_range.0 + o.u_range.1) { 1.0 } else { -1.0 };
-                let side_v = if vs[j] < 0.5 * (dom.start + dom.end) { 1.0 } else { -1.0 };
+                let side_u = if us[i] < u_mid { 1.0 } else { -1.0 };
+                let side_v = if vs[j] < v_mid { 1.0 } else { -1.0 };
                 nrm = if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v };
             }
-            match nrm.normalized() {
-                Some(n) => normals.push(n),
-                None => {
-                    normals.push(Vec3::ZERO);
-                    missing.push(i * o.nv + j);
-                }
-            }
-            positions.push(p);
-            uvs.push([i as f64 / (o.nu - 1) as f64, j as f64 / (o.nv - 1) as f64]);
+            *nm = nrm.normalized().unwrap_or(Vec3::new(f64::NAN, 0.0, 0.0));
         }
+    });
+    let missing: Vec<usize> = (0..n).filter(|&k| normals[k].x.is_nan()).collect();
+    for &k in &missing {
+        normals[k] = Vec3::ZERO;
     }
+    let positions: Vec<Vec3> = flat.par_iter().map(|d| d[0]).collect();
+    let (fu, fv) = (1.0 / (o.nu - 1) as f64, 1.0 / (o.nv - 1) as f64);
+    let uvs: Vec<[f64; 2]> = (0..n).into_par_iter().map(|k| [(k / o.nv) as f64 * fu, (k % o.nv) as f64 * fv]).collect();
     for &k in &missing {
         let (i, j) = (k / o.nv, k % o.nv);
         let mut acc = Vec3::ZERO;
@@ -88,15 +89,16 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
         }
         normals[k] = acc.normalized().unwrap_or(Vec3::new(0.0, 0.0, 1.0));
     }
-    let mut quads = Vec::with_capacity((o.nu - 1) * (o.nv - 1));
-    for i in 0..o.nu - 1 {
-        for j in 0..o.nv - 1 {
+    // (u, v) → counter-clockwise about X_u × X_v
+    let quads: Vec<[u32; 4]> = (0..(o.nu - 1) * (o.nv - 1))
+        .into_par_iter()
+        .map(|q| {
+            let (i, j) = (q / (o.nv - 1), q % (o.nv - 1));
             let a = (i * o.nv + j) as u32;
             let b = ((i + 1) * o.nv + j) as u32;
-            // (u, v) → counter-clockwise about X_u × X_v
-            quads.push([a, b, b + 1, a + 1]);
-        }
-    }
+            [a, b, b + 1, a + 1]
+        })
+        .collect();
     Ok(Mesh { positions, normals, uvs, quads, grid: Some((o.nu, o.nv)), ..Default::default() })
 }
 

@@ -410,33 +410,35 @@ impl Surface for SpectralPatch {
             })
             .collect();
         let k = self.dtheta_dv;
-        us.par_iter()
-            .flat_map_iter(|&u| {
-                let row = self.row(u, 1);
-                cols.iter()
-                    .map(|col| {
-                        let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
-                        for n in 1..=m {
-                            let (c, s) = col.cs[n];
-                            let nf = n as f64;
-                            let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
-                            p += a0 * c + b0 * s;
-                            pu += a1 * c + b1 * s;
-                            pv += (b0 * c - a0 * s) * nf;
-                            puv += (b1 * c - a1 * s) * nf;
-                        }
-                        for (ci, t) in col.tails.iter().enumerate() {
-                            let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
-                            p += t[0] * l0;
-                            pu += t[0] * l1;
-                            pv += t[1] * l0;
-                            puv += t[1] * l1;
-                        }
-                        [p, pu, pv * k, puv * k]
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect()
+        // one output buffer, rows filled in parallel (no per-row vectors to gather)
+        let mut out = vec![[Vec3::ZERO; 4]; us.len() * vs.len()];
+        if vs.is_empty() {
+            return out;
+        }
+        out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
+            let row = self.row(u, 1);
+            for (o, col) in dst.iter_mut().zip(&cols) {
+                let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
+                for n in 1..=m {
+                    let (c, s) = col.cs[n];
+                    let nf = n as f64;
+                    let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
+                    p += a0 * c + b0 * s;
+                    pu += a1 * c + b1 * s;
+                    pv += (b0 * c - a0 * s) * nf;
+                    puv += (b1 * c - a1 * s) * nf;
+                }
+                for (ci, t) in col.tails.iter().enumerate() {
+                    let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
+                    p += t[0] * l0;
+                    pu += t[0] * l1;
+                    pv += t[1] * l0;
+                    puv += t[1] * l1;
+                }
+                *o = [p, pu, pv * k, puv * k];
+            }
+        });
+        out
     }
 }
 
