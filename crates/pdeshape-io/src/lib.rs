@@ -8,5 +8,6 @@
 pub mod export;
 pub mod model;
 pub mod render;
+pub mod scaling;
 pub mod scene;
 pub mod tables;

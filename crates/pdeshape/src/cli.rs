@@ -119,6 +119,13 @@ enum Command {
         /// Also write the tables to OUT.md and OUT.json.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Run the scaling study instead (resolution, order, modes, collocation size on one
+        /// and two threads; minutes) and write its tables and plots into DIR.
+        #[arg(long, value_name = "DIR")]
+        scaling: Option<PathBuf>,
+        /// Largest grid side of the scaling study.
+        #[arg(long, default_value_t = 2000)]
+        max_side: usize,
     },
     /// Serve the interactive editor (a local web page) on 127.0.0.1.
     Serve {
@@ -464,7 +471,10 @@ fn execute(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, cli.quiet),
-        Command::Bench { json, runs, out } => crate::bench::run(runs, json, out.as_deref()),
+        Command::Bench { scaling: Some(dir), runs, max_side, .. } => {
+            crate::bench::scaling(&dir, runs, max_side, cli.quiet)
+        }
+        Command::Bench { json, runs, out, .. } => crate::bench::run(runs, json, out.as_deref()),
         Command::Serve { scene, port, host, open: _ } => {
             crate::serve::run(crate::serve::ServeOptions { scene, host, port })
         }
