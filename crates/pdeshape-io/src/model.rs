@@ -64,6 +64,22 @@ fn dynamic_animation(
     Ok(anim)
 }
 
+/// The editor's mesh of a patch at time `t`: [`patch_mesh_at`] plus the exact mean
+/// curvature field (of the frame at `t` for a dynamic blend; none for solids).
+pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
+    let mut m = patch_mesh_at(p, t)?;
+    match (&p.dynamic, t) {
+        _ if p.solid.is_some() => {}
+        (Some(d), Some(t)) => {
+            let f = d.blend.frame(t.clamp(d.times.0, d.times.1)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
+            m.add_mean_curvature(&f);
+        }
+        _ => m.add_mean_curvature(p.surface.as_ref()),
+    }
+    m.check_finite()?;
+    Ok(m)
+}
+
 /// The mesh of a patch at time `t` (dynamic blends; other patches ignore `t`).
 pub fn patch_mesh_at(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
     match (&p.dynamic, t) {

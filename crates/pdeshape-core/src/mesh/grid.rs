@@ -103,6 +103,31 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
 }
 
 impl Mesh {
+    /// Adds the exact mean curvature ([`crate::patch::mean_curvature`]) of `s` at every
+    /// vertex as the field `mean_curvature`: on the grid path (`Surface::grid2`) for a
+    /// structured grid mesh over `u ∈ [0, 1]`, else at each vertex's `(u, v)` from its UV
+    /// (`u = uv₀`, `v` the domain at `uv₁`). 0 where it is undefined (poles).
+    pub fn add_mean_curvature(&mut self, s: &dyn Surface) {
+        let jets = match self.grid {
+            Some((nu, nv)) if nu * nv == self.positions.len() => {
+                let (us, vs) = grid_params(s, &GridOptions::new(nu, nv));
+                s.grid2(&us, &vs)
+            }
+            _ => {
+                let dom = s.v_domain();
+                self.uvs
+                    .par_iter()
+                    .map(|uv| {
+                        let d = s.derivatives(uv[0], dom.at(uv[1]), 2, 2);
+                        [d[0], d[3], d[1], d[6], d[4], d[2]]
+                    })
+                    .collect()
+            }
+        };
+        let values = jets.par_iter().map(|j| crate::patch::mean_curvature(j).unwrap_or(0.0)).collect();
+        self.fields.push(ScalarField { name: "mean_curvature".into(), values });
+    }
+
     /// Adds a per-vertex field computed from `(u, v)` of a structured grid mesh.
     pub fn add_grid_field(&mut self, name: &str, s: &dyn Surface, f: impl Fn(&dyn Surface, f64, f64) -> f64 + Sync) {
         let Some((nu, nv)) = self.grid else { return };
@@ -137,6 +162,20 @@ mod tests {
                 }
             }
             out
+        }
+    }
+
+    #[test]
+    fn mean_curvature_of_the_unit_sphere_is_one_and_undefined_at_the_poles() {
+        let us = [0.0, 0.1, 0.37, 0.5, 0.81];
+        let vs = [0.0, 1.0, 2.5, 4.0];
+        let g = Sphere.grid2(&us, &vs);
+        for (k, j) in g.iter().enumerate() {
+            let u = us[k / vs.len()];
+            match crate::patch::mean_curvature(j) {
+                Some(h) => assert!((h.abs() - 1.0).abs() < 1e-12, "u = {u}: H = {h}"),
+                None => assert_eq!(u, 0.0, "H undefined away from the pole"),
+            }
         }
     }
 

@@ -80,10 +80,52 @@ pub trait Surface: Send + Sync {
             .collect()
     }
 
+    /// Values with first and second derivatives `[X, X_u, X_v, X_uu, X_uv, X_vv]` on the
+    /// grid `us × vs` (row-major in `u`), e.g. for exact curvature. Solvers override this
+    /// to share per-row and per-column work.
+    fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
+        use rayon::prelude::*;
+        us.par_iter()
+            .flat_map_iter(|&u| {
+                vs.iter().map(move |&v| {
+                    // index i·3 + j of ∂ⁱ_u ∂ʲ_v
+                    let d = self.derivatives(u, v, 2, 2);
+                    [d[0], d[3], d[1], d[6], d[4], d[2]]
+                })
+            })
+            .collect()
+    }
+
     /// `∂ᵏX/∂uᵏ (u, v)`.
     fn u_derivative(&self, u: f64, v: f64, k: usize) -> Vec3 {
         self.derivatives(u, v, k, 0)[k]
     }
+}
+
+/// Mean curvature `H = (E N − 2 F M + G L) / (2 (E G − F²))` from the jets
+/// `[X, X_u, X_v, X_uu, X_uv, X_vv]` (first fundamental form `E, F, G`, second `L, M, N`
+/// against the unit normal `n = X_u × X_v / |X_u × X_v|`): positive where the surface bends
+/// towards `n`. `None` where `X_u × X_v` vanishes (a pole).
+///
+/// ```
+/// use pdeshape_core::{Vec3, patch::mean_curvature};
+/// // the cylinder (cos v, sin v, u) at v = 0: n points to the axis, H = 1/(2R)
+/// let j = [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 0.0),
+///          Vec3::ZERO, Vec3::ZERO, Vec3::new(-1.0, 0.0, 0.0)];
+/// assert!((mean_curvature(&j).unwrap() - 0.5).abs() < 1e-15);
+/// ```
+pub fn mean_curvature(j: &[Vec3; 6]) -> Option<f64> {
+    let [_, xu, xv, xuu, xuv, xvv] = *j;
+    let n = xu.cross(xv);
+    let area2 = n.dot(n);
+    let scale = xu.dot(xu) * xv.dot(xv);
+    if !(area2 > 1e-24 * scale && area2.is_finite()) {
+        return None;
+    }
+    let n = n * (1.0 / area2.sqrt());
+    let (e, f, g) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
+    let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
+    Some((e * nn - 2.0 * f * m + g * l) / (2.0 * area2))
 }
 
 /// Result of checking a patch against its conditions.

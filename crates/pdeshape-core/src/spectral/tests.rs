@@ -197,12 +197,19 @@ fn grid_evaluation_matches_pointwise_derivatives() {
         let us = [0.0, 0.3, 0.77, 1.0];
         let vs = [dom.at(0.1), dom.at(0.45), dom.at(0.9)];
         let g = p.grid(&us, &vs);
+        let g2 = p.grid2(&us, &vs);
         for (i, &u) in us.iter().enumerate() {
             for (j, &v) in vs.iter().enumerate() {
                 let d = p.derivatives(u, v, 1, 1);
                 let want = [d[0], d[2], d[1], d[3]];
                 for k in 0..4 {
                     assert!((g[i * vs.len() + j][k] - want[k]).norm() < 1e-12, "({u}, {v}) entry {k}");
+                }
+                let d = p.derivatives(u, v, 2, 2);
+                let want = [d[0], d[3], d[1], d[6], d[4], d[2]];
+                for k in 0..6 {
+                    let scale = 1.0 + want[k].norm();
+                    assert!((g2[i * vs.len() + j][k] - want[k]).norm() < 1e-12 * scale, "({u}, {v}) jet {k}");
                 }
             }
         }

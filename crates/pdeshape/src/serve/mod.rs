@@ -181,7 +181,7 @@ pub fn solve(req: &ModelRequest) -> Result<(Scene, String, Vec<Mesh>), String> {
             "the model would have {estimate} vertices; the editor's limit is {MAX_VERTICES} (lower the patches' `resolution`)"
         ));
     }
-    let meshes = scene.patches.iter().map(|p| model::patch_mesh_at(p, req.time)).collect::<Result<Vec<_>, _>>()?;
+    let meshes = scene.patches.iter().map(|p| model::editor_mesh(p, req.time)).collect::<Result<Vec<_>, _>>()?;
     Ok((scene, text, meshes))
 }
 
@@ -288,7 +288,7 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
             .iter()
             .map(|c| put_f32(&mut buf, &mut c.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])))
             .collect();
-        let mut fields: Vec<Value> = m
+        let fields: Vec<Value> = m
             .fields
             .iter()
             .map(|f| {
@@ -297,7 +297,6 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
                 v
             })
             .collect();
-        fields.extend(curvature_field(&mut buf, m, &tris));
         let trim = p.trim.as_ref().map(|t| {
             let g = &t.grid;
             let ring0: Vec<[f64; 2]> = (0..=g.columns).map(|j| g.points[g.index(0, j)]).collect();
@@ -353,36 +352,4 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
     out.extend_from_slice(&h);
     out.extend_from_slice(&buf);
     out
-}
-
-/// Mean curvature from the mesh normals (a per-vertex field for the colour map):
-/// `H ≈ ½ Σ (n_j − n_i)·(p_j − p_i)/|p_j − p_i|²` over the mesh neighbours (a display
-/// estimate; the exact field is `check`'s business).
-fn curvature_field(buf: &mut Vec<u8>, m: &Mesh, tris: &[[u32; 3]]) -> Option<Value> {
-    if m.normals.len() != m.positions.len() || m.positions.is_empty() {
-        return None;
-    }
-    let n = m.positions.len();
-    let mut acc = vec![0.0f64; n];
-    let mut cnt = vec![0u32; n];
-    for t in tris {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let d = m.positions[b] - m.positions[a];
-            let l2 = d.dot(d);
-            if l2 > 0.0 {
-                let c = (m.normals[b] - m.normals[a]).dot(d) / l2;
-                acc[a] += c;
-                acc[b] += c;
-                cnt[a] += 1;
-                cnt[b] += 1;
-            }
-        }
-    }
-    let offset = buf.len();
-    for i in 0..n {
-        let v = if cnt[i] > 0 { 0.5 * acc[i] / cnt[i] as f64 } else { 0.0 };
-        buf.extend_from_slice(&(v as f32).to_le_bytes());
-    }
-    Some(json!({"name": "mean_curvature (display)", "offset": offset, "count": n}))
 }
