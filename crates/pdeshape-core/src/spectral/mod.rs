@@ -32,7 +32,7 @@ use crate::patch::{Condition, Surface, VDomain};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::PI;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Options of the spectral solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,9 +88,18 @@ pub struct SpectralPatch {
     series: Vec<FourierSeries>,
     cards: Vec<Arc<CardinalSet>>,
     rem: Arc<CardinalSet>,
+    /// Order of the derivatives tabulated on demand (`2N` for `N ≤ 10`, else none beyond
+    /// what the solve tabulated) and the cardinal functions tabulated to it: computed the
+    /// first time a derivative above the solve's order is asked for (the PDE residual,
+    /// high-order jets of a curve on this patch), not by every solve.
+    deep_kmax: usize,
+    deep: OnceLock<Option<CardSets>>,
     time: f64,
     cache: Mutex<HashMap<(u64, usize), Arc<Row>>>,
 }
+
+/// The modes' cardinal sets and the remainder's.
+type CardSets = (Vec<Arc<CardinalSet>>, Arc<CardinalSet>);
 
 impl std::fmt::Debug for SpectralPatch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -162,9 +171,9 @@ impl SpectralPatch {
         }
         let specs: Vec<CondSpec> = conds.iter().map(|c| CondSpec { u: c.u, order: c.order }).collect();
         let dmax = specs.iter().map(|c| c.order).max().unwrap_or(0);
-        // Tabulate what evaluation needs (normals, curvature, conditions) and, where it is
-        // affordable, the 2N-th derivatives for the PDE residual.
-        let kmax = dmax.max(2).max(if n <= 10 { 2 * n } else { 0 });
+        // Tabulate what evaluation needs (normals, curvature, conditions); the 2N-th
+        // derivatives for the PDE residual, where affordable, only when asked for.
+        let kmax = dmax.max(2);
         let (data, dtheta_dv): (Vec<FieldRef>, f64) = if domain.periodic {
             (conds.iter().map(|c| c.data.clone()).collect(), 1.0)
         } else {
@@ -206,6 +215,8 @@ impl SpectralPatch {
             series,
             cards,
             rem,
+            deep_kmax: if n <= 10 { 2 * n } else { 0 },
+            deep: OnceLock::new(),
             time: 0.0,
             cache: Mutex::new(HashMap::new()),
         })
@@ -251,6 +262,27 @@ impl SpectralPatch {
         if self.domain.periodic { v } else { (v - self.domain.start) * self.dtheta_dv }
     }
 
+    /// Cardinal sets that hold derivatives up to `k` if any do: the solve's, or the ones
+    /// tabulated to `deep_kmax` on demand.
+    fn sets(&self, k: usize) -> (&[Arc<CardinalSet>], &Arc<CardinalSet>) {
+        let fast = self.cards.iter().all(|c| c.kmax() >= k) && self.rem.kmax() >= k;
+        if fast || k > self.deep_kmax {
+            return (&self.cards, &self.rem);
+        }
+        let deep = self.deep.get_or_init(|| {
+            let (n, a, kk) = (self.n, self.opts.a, self.deep_kmax);
+            let cards: Option<Vec<_>> = (0..=self.opts.modes)
+                .into_par_iter()
+                .map(|m| cardinal_set(a * m as f64, n, &self.conds, kk).ok())
+                .collect();
+            Some((cards?, cardinal_set(self.omega, n, &self.conds, kk).ok()?))
+        });
+        match deep {
+            Some((c, r)) => (c, r),
+            None => (&self.cards, &self.rem),
+        }
+    }
+
     fn row(&self, u: f64, k: usize) -> Arc<Row> {
         let key = (u.to_bits(), k);
         if let Some(r) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
@@ -259,7 +291,8 @@ impl SpectralPatch {
         let m = self.opts.modes;
         let mut a = vec![vec![Vec3::ZERO; m + 1]; k + 1];
         let mut b = vec![vec![Vec3::ZERO; m + 1]; k + 1];
-        for (mode, card) in self.cards.iter().enumerate() {
+        let (cards, rem) = self.sets(k);
+        for (mode, card) in cards.iter().enumerate() {
             let l = card.eval(u, k);
             for (kk, lk) in l.iter().enumerate() {
                 for (i, s) in self.series.iter().enumerate() {
@@ -268,7 +301,7 @@ impl SpectralPatch {
                 }
             }
         }
-        let row = Arc::new(Row { a, b, l: self.rem.eval(u, k) });
+        let row = Arc::new(Row { a, b, l: rem.eval(u, k) });
         if let Ok(mut c) = self.cache.lock() {
             if c.len() > 4096 {
                 c.clear();
@@ -332,7 +365,8 @@ impl SpectralPatch {
         let theta = self.theta(v);
         let binom = |n: usize, k: usize| (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64);
         let a2 = self.opts.a * self.opts.a;
-        let trunc = self.cards.iter().all(|c| c.kmax() >= k).then(|| {
+        let (cards, rem_set) = self.sets(k);
+        let trunc = cards.iter().all(|c| c.kmax() >= k).then(|| {
             let row = self.row(u, k);
             let zero_tails: Vec<Vec<Vec3>> = vec![vec![Vec3::ZERO; k + 1]; self.conds.len()];
             let mut r = Vec3::ZERO;
@@ -342,8 +376,8 @@ impl SpectralPatch {
             }
             r
         });
-        let rem = (self.rem.kmax() >= k).then(|| {
-            let l = self.rem.eval(u, k);
+        let rem = (rem_set.kmax() >= k).then(|| {
+            let l = rem_set.eval(u, k);
             let tails = self.tails(theta, k);
             let mut rem = Vec3::ZERO;
             for q in 0..=n {
