@@ -11,7 +11,10 @@
 //! - [`ExpSpace`] is `K` with a *bounded* real basis: `(u − 1)ᵏ e^{r(u−1)}` for
 //!   `Re r > 0`, `uᵏ e^{r u}` otherwise (real and imaginary parts for complex `r`),
 //!   every function of modulus ≤ 1 on `[0, 1]` up to the polynomial factor; a zero root of
-//!   multiplicity `m` uses Chebyshev polynomials `T_k(2u − 1)`, `k < m`.
+//!   multiplicity `m` uses Chebyshev polynomials `T_k(2u − 1)`, `k < m`. Distinct roots
+//!   closer than [`CLUSTER_GAP`] share the divided differences `e[z_0, …, z_k]` of
+//!   `z ↦ e^{z(u − anchor)}` instead, which stay independent as the roots coalesce
+//!   (separate exponentials of roots `δ` apart are dependent to `O(δ)`).
 //! - [`polynomial_roots`] finds the roots of a general real characteristic polynomial
 //!   with their multiplicities, and [`ExpSpace::from_polynomial`] builds `K` from it.
 //! - [`Cardinal`] holds the cardinal functions of a condition set, solved by LU with full
@@ -29,4 +32,4 @@ pub use cardinal::{Cardinal, CondSpec, OdeError};
 pub use poly::{CLUSTER_TOL, PolyRoots, polynomial_from_roots, polynomial_roots};
 pub use precise::ChebCardinal;
 pub use set::{CardinalSet, F64_COND_LIMIT};
-pub use space::{ExpSpace, Root};
+pub use space::{CLUSTER_GAP, ExpSpace, Root};
