@@ -2,7 +2,7 @@
 
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
-use pdeshape_core::blend::{Gaps, Solver, StaticBlend, continuity, gaps_at};
+use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, continuity, gaps_at};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
 use pdeshape_core::patch::{Condition, Surface};
@@ -15,10 +15,16 @@ pub const CHECK_SAMPLES: usize = 1000;
 /// Meshes one patch at its resolution, with its position conditions as highlighted
 /// curves. Fails when the patch is not finite somewhere.
 pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
+    let m = unchecked_mesh(p)?;
+    m.check_finite()?;
+    Ok(m)
+}
+
+/// [`patch_mesh`] before its finiteness check.
+fn unchecked_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     if let Some(sd) = &p.solid {
         let mut m = pdeshape_core::solid::boundary_mesh(&sd.blend, sd.cells);
         m.name = p.name.clone();
-        m.check_finite()?;
         return Ok(m);
     }
     let (nu, nv) = p.resolution;
@@ -31,8 +37,12 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     m.name = p.name.clone();
     let dom = p.surface.v_domain();
     let n = (4 * nv).max(64);
-    // the position conditions' curves, evaluated together on the grid path (rows shared)
-    let us: Vec<f64> = p.conditions.iter().filter(|c| c.order == 0 && p.trim.is_none()).map(|c| c.u).collect();
+    // the position conditions' curves (none on a trimmed patch), evaluated together on the
+    // grid path (rows shared)
+    let us: Vec<f64> = match p.trim {
+        Some(_) => Vec::new(),
+        None => p.conditions.iter().filter(|c| c.order == 0).map(|c| c.u).collect(),
+    };
     if !us.is_empty() {
         let vs: Vec<f64> = (0..=n).map(|k| dom.at(k as f64 / n as f64)).collect();
         let g = p.surface.grid(&us, &vs);
@@ -44,7 +54,6 @@ pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     if let Some(d) = &p.dynamic {
         m.animation = Some(dynamic_animation(p, d)?);
     }
-    m.check_finite()?;
     Ok(m)
 }
 
@@ -57,7 +66,7 @@ fn dynamic_animation(
     let times = d.frame_times();
     let mut anim = pdeshape_core::mesh::MorphAnimation { times: times.clone(), positions: vec![], normals: vec![] };
     for &t in &times {
-        let fm = frame_mesh(p, d, t)?;
+        let (fm, _) = frame_mesh(p, d, t)?;
         anim.positions.push(fm.positions);
         anim.normals.push(fm.normals);
     }
@@ -67,15 +76,19 @@ fn dynamic_animation(
 /// The editor's mesh of a patch at time `t`: [`patch_mesh_at`] plus the exact mean
 /// curvature field (of the frame at `t` for a dynamic blend; none for solids).
 pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
-    let mut m = patch_mesh_at(p, t)?;
-    match (&p.dynamic, t) {
-        _ if p.solid.is_some() => {}
+    let m = match (&p.dynamic, t) {
+        _ if p.solid.is_some() => unchecked_mesh(p)?,
         (Some(d), Some(t)) => {
-            let f = d.blend.frame(t.clamp(d.times.0, d.times.1)).map_err(|e| format!("patch `{}`: {e}", p.name))?;
-            m.add_mean_curvature(&f);
+            let (mut m, frame) = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
+            m.add_mean_curvature(&frame);
+            m
         }
-        _ => m.add_mean_curvature(p.surface.as_ref()),
-    }
+        _ => {
+            let mut m = unchecked_mesh(p)?;
+            m.add_mean_curvature(p.surface.as_ref());
+            m
+        }
+    };
     m.check_finite()?;
     Ok(m)
 }
@@ -84,8 +97,7 @@ pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
 pub fn patch_mesh_at(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
     match (&p.dynamic, t) {
         (Some(d), Some(t)) => {
-            let mut m = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
-            m.name = p.name.clone();
+            let (m, _) = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
             m.check_finite()?;
             Ok(m)
         }
@@ -99,7 +111,7 @@ pub fn frame_meshes(p: &ScenePatch) -> Option<Result<Vec<Mesh>, String>> {
     let run = || -> Result<Vec<Mesh>, String> {
         let mut out = Vec::new();
         for (i, t) in d.frame_times().into_iter().enumerate() {
-            let mut m = frame_mesh(p, d, t)?;
+            let (mut m, _) = frame_mesh(p, d, t)?;
             m.name = format!("{}-{i:03}", p.name);
             m.check_finite()?;
             out.push(m);
@@ -313,13 +325,7 @@ pub fn dynamic_strip(scene: &Scene) -> Option<Result<Image, String>> {
         let mut panels = Vec::new();
         for &t in &times {
             let context = context_meshes_at(scene, t)?;
-            let mut meshes = Vec::new();
-            for p in &scene.patches {
-                match &p.dynamic {
-                    Some(dy) => meshes.push(frame_mesh(p, dy, t)?),
-                    None => meshes.push(patch_mesh(p)?),
-                }
-            }
+            let meshes = scene.patches.iter().map(|p| patch_mesh_at(p, Some(t))).collect::<Result<Vec<_>, _>>()?;
             let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
             let img = render_meshes(&meshes, &context, &colors, &r);
             panels.push(captioned(&img, &format!("t = {t:.2}"), 34, 22.0));
@@ -361,13 +367,14 @@ fn captioned(img: &Image, text: &str, band: u32, size: f32) -> Image {
     panel
 }
 
-/// The mesh of a dynamic patch's frame at time `t`, at the patch's resolution.
-fn frame_mesh(p: &ScenePatch, dy: &crate::scene::DynamicSetup, t: f64) -> Result<Mesh, String> {
+/// The mesh of a dynamic patch's frame at time `t`, at the patch's resolution, and the
+/// frame surface it meshes.
+fn frame_mesh(p: &ScenePatch, dy: &crate::scene::DynamicSetup, t: f64) -> Result<(Mesh, DynamicFrame), String> {
     let f = dy.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
     let mut m = grid_mesh(&f, &GridOptions::new(p.resolution.0, p.resolution.1))
         .map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
     m.name = p.name.clone();
-    Ok(m)
+    Ok((m, f))
 }
 
 fn palette(k: usize) -> [f64; 3] {
