@@ -155,12 +155,6 @@ impl fmt::Display for Cap {
     }
 }
 
-/// Estimated bytes of a surface mesh with `vertices` vertices: positions, normals, UVs,
-/// two triangles' indices per vertex and `fields` per-vertex `f64` fields.
-pub fn surface_mesh_bytes(vertices: usize, fields: usize) -> u128 {
-    vertices as u128 * (24 + 24 + 16 + 24 + 8 * fields as u128)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

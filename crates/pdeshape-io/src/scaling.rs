@@ -9,7 +9,7 @@ use crate::render::Image;
 use crate::render::{Series, line_plot};
 use crate::scene::{LoadOptions, Scene};
 use crate::tables::{Timing, time};
-use pdeshape_core::mesh::{GridOptions, Mesh, grid_mesh};
+use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -37,11 +37,6 @@ pub struct ScalingOptions {
     pub runs: usize,
     /// Largest grid side (the study goes 50, 100, 200, 500, 1000, 2000 up to it).
     pub max_side: usize,
-}
-
-/// Bytes of a mesh's arrays.
-pub fn mesh_bytes(m: &Mesh) -> usize {
-    m.positions.len() * 24 + m.normals.len() * 24 + m.uvs.len() * 16 + m.quads.len() * 16 + m.triangles.len() * 12
 }
 
 fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
@@ -87,7 +82,7 @@ fn solve_and_mesh(
         let mesh = time(runs, || {
             let _ = std::hint::black_box(grid_mesh(s.as_ref(), &opts));
         });
-        Ok((solve, mesh, mesh_bytes(&m)))
+        Ok((solve, mesh, m.bytes()))
     })
 }
 
@@ -147,7 +142,7 @@ pub fn run(
                 let t = time(runs, || {
                     let _ = std::hint::black_box(grid_mesh(surface.as_ref(), &opts));
                 });
-                Ok::<_, String>((t, mesh_bytes(&m)))
+                Ok::<_, String>((t, m.bytes()))
             })?;
             rows.push(ScalingRow {
                 study: "resolution",

@@ -402,6 +402,11 @@ fn caps_name_themselves_and_how_to_raise_them() {
         &["--limit", "memory=1"],
         &["patches.p", "estimated memory", "`memory` cap of 1 MiB", "--limit memory="],
     );
+    // a solid's point set: the Gauss grid (3L + 24)(3M + 24)(2N + 24) = 84·84·64
+    let solid = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/solid-cubes.toml"))
+        .unwrap()
+        .replace("lmn = [6, 6, 6]", "lmn = [20, 20, 20]");
+    fails(&solid, &["lmn", "451584", "`collocation` cap of 250000", "--limit collocation=451584"]);
     fails_with(&good(), &["--limit", "colour=3"], &["unknown cap `colour`", "order, modes, collocation"]);
     fails_with(&good(), &["--limit", "order=many"], &["not a whole number"]);
 }

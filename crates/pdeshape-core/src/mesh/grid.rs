@@ -57,24 +57,30 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     let dom = s.v_domain();
     let u_mid = 0.5 * (o.u_range.0 + o.u_range.1);
     let v_mid = 0.5 * (dom.start + dom.end);
-    // normals (NaN marks a vertex where even the limit vanishes), in parallel by rows
+    // normals in parallel by rows; the vertices where even the limit vanishes, in order
     let mut normals = vec![Vec3::ZERO; n];
-    normals.par_chunks_mut(o.nv).zip(flat.par_chunks(o.nv)).enumerate().for_each(|(i, (dst, row))| {
-        for (j, (nm, d)) in dst.iter_mut().zip(row).enumerate() {
-            let [_, pu, pv, puv] = *d;
-            let mut nrm = pu.cross(pv);
-            if nrm.norm() <= 1e-9 * reference {
-                let side_u = if us[i] < u_mid { 1.0 } else { -1.0 };
-                let side_v = if vs[j] < v_mid { 1.0 } else { -1.0 };
-                nrm = if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v };
+    let missing: Vec<usize> = normals
+        .par_chunks_mut(o.nv)
+        .zip(flat.par_chunks(o.nv))
+        .enumerate()
+        .flat_map_iter(|(i, (dst, row))| {
+            let mut gone = Vec::new();
+            for (j, (nm, d)) in dst.iter_mut().zip(row).enumerate() {
+                let [_, pu, pv, puv] = *d;
+                let mut nrm = pu.cross(pv);
+                if nrm.norm() <= 1e-9 * reference {
+                    let side_u = if us[i] < u_mid { 1.0 } else { -1.0 };
+                    let side_v = if vs[j] < v_mid { 1.0 } else { -1.0 };
+                    nrm = if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v };
+                }
+                match nrm.normalized() {
+                    Some(unit) => *nm = unit,
+                    None => gone.push(i * o.nv + j),
+                }
             }
-            *nm = nrm.normalized().unwrap_or(Vec3::new(f64::NAN, 0.0, 0.0));
-        }
-    });
-    let missing: Vec<usize> = (0..n).filter(|&k| normals[k].x.is_nan()).collect();
-    for &k in &missing {
-        normals[k] = Vec3::ZERO;
-    }
+            gone
+        })
+        .collect();
     let positions: Vec<Vec3> = flat.par_iter().map(|d| d[0]).collect();
     let (fu, fv) = (1.0 / (o.nu - 1) as f64, 1.0 / (o.nv - 1) as f64);
     let uvs: Vec<[f64; 2]> = (0..n).into_par_iter().map(|k| [(k / o.nv) as f64 * fu, (k % o.nv) as f64 * fv]).collect();
@@ -190,5 +196,13 @@ mod tests {
         let s0 = m.positions[20].dot(m.normals[20]).signum();
         assert!(m.positions.iter().zip(&m.normals).all(|(p, n)| p.dot(*n).signum() == s0));
         assert_eq!(m.quads.len(), 8 * 12);
+    }
+
+    #[test]
+    fn grid_bytes_bounds_the_bytes_of_a_grid_mesh() {
+        let mut m = grid_mesh(&Sphere, &GridOptions::new(30, 41)).unwrap();
+        m.add_mean_curvature(&Sphere);
+        let (have, bound) = (m.bytes() as u128, Mesh::grid_bytes(30 * 41, 1, 0));
+        assert!(have <= bound && have as f64 > 0.95 * bound as f64, "{have} vs {bound}");
     }
 }

@@ -82,6 +82,27 @@ impl Mesh {
         self.fields.iter().find(|f| f.name == name)
     }
 
+    /// Bytes held by the mesh's vertex, face, field and animation arrays (not the curves).
+    pub fn bytes(&self) -> usize {
+        let v3 = std::mem::size_of::<Vec3>();
+        let frames = self.animation.as_ref().map_or(0, |a| {
+            a.positions.iter().chain(&a.normals).map(|f| f.len() * v3).sum::<usize>() + a.times.len() * 8
+        });
+        (self.positions.len() + self.normals.len()) * v3
+            + self.uvs.len() * 16
+            + self.quads.len() * 16
+            + self.triangles.len() * 12
+            + self.fields.iter().map(|f| f.values.len() * 8).sum::<usize>()
+            + frames
+    }
+
+    /// An upper bound of [`bytes`](Self::bytes) for a structured grid mesh of `vertices`
+    /// vertices with normals, UVs, quads (fewer than one per vertex), `fields` per-vertex
+    /// fields and `frames` animation frames: `80 + 8·fields + 48·frames` bytes per vertex.
+    pub fn grid_bytes(vertices: usize, fields: usize, frames: usize) -> u128 {
+        vertices as u128 * (24 + 24 + 16 + 16 + 8 * fields as u128 + 48 * frames as u128)
+    }
+
     /// Checks that every coordinate, normal and field value is finite.
     pub fn check_finite(&self) -> Result<(), String> {
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {

@@ -65,6 +65,29 @@ impl Default for SolidOptions {
     }
 }
 
+impl SolidOptions {
+    /// The Gauss rules `(3L + 24, 3M + 24, 2N + 24)` in `u`, `v`, `w` on which the
+    /// separated fits (complete and Galerkin trial spaces) integrate the residual.
+    pub fn quadrature(&self) -> (usize, usize, usize) {
+        let (l, m, n) = self.terms;
+        (3 * l + 24, 3 * m + 24, 2 * n + 24)
+    }
+
+    /// The size of the solve's point set: the points of the Gauss grid
+    /// ([`quadrature`](Self::quadrature)) for the separated fits, the `L·M·N` collocation
+    /// rows otherwise. The loader caps it (`collocation`).
+    pub fn points(&self) -> u128 {
+        let (l, m, n) = self.terms;
+        match self.trial {
+            Trial::Complete | Trial::Galerkin => {
+                let (a, b, c) = self.quadrature();
+                a as u128 * b as u128 * c as u128
+            }
+            Trial::Collocation | Trial::Paper => l as u128 * m as u128 * n as u128,
+        }
+    }
+}
+
 /// What the solve did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolidReport {
@@ -173,13 +196,14 @@ impl SolidBlend {
     #[allow(clippy::needless_range_loop)] // (l, m) index the coefficient tensor and tables
     fn solve_separated(&mut self, galerkin: bool) -> Result<(), SolidError> {
         let (nl, nm, nn) = self.opts.terms;
-        let (xw, ww) = gauss_legendre(2 * nn + 24);
+        let (qu, qv, qw) = self.opts.quadrature();
+        let (xw, ww) = gauss_legendre(qw);
         let p0: Vec<Vec<f64>> = xw.iter().map(|&w| (1..=nn).map(|n| psi(Trial::Complete, n, w, 0)).collect()).collect();
         let p4: Vec<Vec<f64>> = xw.iter().map(|&w| (1..=nn).map(|n| psi(Trial::Complete, n, w, 4)).collect()).collect();
         let hs: Vec<[[f64; 5]; 4]> = xw.iter().map(|&w| cubic_hermite(w)).collect();
         // u, v: ∫∫ R_f sin lπu sin mπv
-        let (xu, wu) = gauss_legendre(3 * nl + 24);
-        let (xv, wv) = gauss_legendre(3 * nm + 24);
+        let (xu, wu) = gauss_legendre(qu);
+        let (xv, wv) = gauss_legendre(qv);
         let rf: Vec<Vec<[Vec3; 4]>> =
             xu.par_iter().map(|&u| xv.iter().map(|&v| self.face_residuals(u, v)).collect()).collect();
         let mut cond: f64 = 1.0;

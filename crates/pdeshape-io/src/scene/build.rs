@@ -1047,10 +1047,8 @@ fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<Sc
         }
         let k = format!("{key}.lmn");
         ctx.cap(Cap::Modes, a.max(b).max(c) as u128, span(l), &k, &format!("the largest of [{a}, {b}, {c}] (`{k}`)"))?;
-        // the Gauss grid of the least-squares fit (see `SolidBlend::new`)
-        let points = (3 * a as u128 + 24) * (3 * b as u128 + 24) * (2 * c as u128 + 24);
-        ctx.cap(Cap::Collocation, points, span(l), &k, &format!("the quadrature grid of [{a}, {b}, {c}]"))?;
         opts.terms = (a as usize, b as usize, c as usize);
+        ctx.cap(Cap::Collocation, opts.points(), span(l), &k, &format!("the point set of [{a}, {b}, {c}]"))?;
     }
     let cells = match &rp.cells {
         None => (17, 33, 17),

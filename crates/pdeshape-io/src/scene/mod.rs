@@ -133,19 +133,21 @@ impl ScenePatch {
     /// exporters hold): the surface grid or trimmed grid with its per-vertex fields, every
     /// frame of a dynamic blend, the hexahedral cells of a solid.
     pub fn memory_estimate(&self) -> u128 {
-        use pdeshape_core::limits::surface_mesh_bytes;
+        use pdeshape_core::mesh::Mesh;
         if let Some(sd) = &self.solid {
+            // per cell about one vertex (24 bytes), four fields and eight indices; the
+            // boundary as a surface mesh
             let (a, b, c) = sd.cells;
             let cells = a as u128 * b as u128 * c as u128;
-            return cells * (24 + 8 * 4 + 32) + surface_mesh_bytes(2 * (a * b + b * c + a * c), 0);
+            return cells * (24 + 8 * 4 + 32) + Mesh::grid_bytes(2 * (a * b + b * c + a * c), 0, 0);
         }
         let vertices = match &self.trim {
             Some(t) => t.grid.rings * (t.grid.columns + 1),
             None => self.resolution.0 * self.resolution.1,
         };
         let fields = if self.blend.is_some() { 5 } else { 0 };
-        let frames = self.dynamic.as_ref().map_or(0, |d| d.frames as u128);
-        surface_mesh_bytes(vertices, fields) + frames * vertices as u128 * 48
+        let frames = self.dynamic.as_ref().map_or(0, |d| d.frames);
+        Mesh::grid_bytes(vertices, fields, frames)
     }
 }
 
