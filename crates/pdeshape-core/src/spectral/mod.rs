@@ -429,79 +429,60 @@ impl Surface for SpectralPatch {
         // Per column: cos nθ, sin nθ and the tails with their θ-derivative; per row: the
         // mode functions and their u-derivative. Each point is then a dense sum.
         let m = self.opts.modes;
-        let cols = self.grid_columns(vs, 1);
         let k = self.dtheta_dv;
-        // one output buffer, rows filled in parallel (no per-row vectors to gather)
-        let mut out = vec![[Vec3::ZERO; 4]; us.len() * vs.len()];
-        if vs.is_empty() {
-            return out;
-        }
-        out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
-            let row = self.row(u, 1);
-            for (o, col) in dst.iter_mut().zip(&cols) {
-                let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
-                for n in 1..=m {
-                    let (c, s) = col.cs[n];
-                    let nf = n as f64;
-                    let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
-                    p += a0 * c + b0 * s;
-                    pu += a1 * c + b1 * s;
-                    pv += (b0 * c - a0 * s) * nf;
-                    puv += (b1 * c - a1 * s) * nf;
-                }
-                for (ci, t) in col.tails.iter().enumerate() {
-                    let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
-                    p += t[0] * l0;
-                    pu += t[0] * l1;
-                    pv += t[1] * l0;
-                    puv += t[1] * l1;
-                }
-                *o = [p, pu, pv * k, puv * k];
+        self.grid_rows(us, vs, 1, |row, col| {
+            let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
+            for n in 1..=m {
+                let (c, s) = col.cs[n];
+                let nf = n as f64;
+                let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
+                p += a0 * c + b0 * s;
+                pu += a1 * c + b1 * s;
+                pv += (b0 * c - a0 * s) * nf;
+                puv += (b1 * c - a1 * s) * nf;
             }
-        });
-        out
+            for (ci, t) in col.tails.iter().enumerate() {
+                let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
+                p += t[0] * l0;
+                pu += t[0] * l1;
+                pv += t[1] * l0;
+                puv += t[1] * l1;
+            }
+            [p, pu, pv * k, puv * k]
+        })
     }
 
     fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
         // as `grid`, with the second derivatives: ∂θ² of cos nθ, sin nθ is −n² times them
         let m = self.opts.modes;
-        let cols = self.grid_columns(vs, 2);
         let (k, k2) = (self.dtheta_dv, self.dtheta_dv * self.dtheta_dv);
-        let mut out = vec![[Vec3::ZERO; 6]; us.len() * vs.len()];
-        if vs.is_empty() {
-            return out;
-        }
-        out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
-            let row = self.row(u, 2);
-            for (o, col) in dst.iter_mut().zip(&cols) {
-                let [mut p, mut pu, mut puu] = [row.a[0][0], row.a[1][0], row.a[2][0]];
-                let [mut pv, mut puv, mut pvv] = [Vec3::ZERO; 3];
-                for n in 1..=m {
-                    let (c, s) = col.cs[n];
-                    let nf = n as f64;
-                    let (a0, b0) = (row.a[0][n], row.b[0][n]);
-                    let (a1, b1) = (row.a[1][n], row.b[1][n]);
-                    let value = a0 * c + b0 * s;
-                    p += value;
-                    pu += a1 * c + b1 * s;
-                    puu += row.a[2][n] * c + row.b[2][n] * s;
-                    pv += (b0 * c - a0 * s) * nf;
-                    puv += (b1 * c - a1 * s) * nf;
-                    pvv -= value * (nf * nf);
-                }
-                for (ci, t) in col.tails.iter().enumerate() {
-                    let (l0, l1, l2) = (row.l[0][ci], row.l[1][ci], row.l[2][ci]);
-                    p += t[0] * l0;
-                    pu += t[0] * l1;
-                    puu += t[0] * l2;
-                    pv += t[1] * l0;
-                    puv += t[1] * l1;
-                    pvv += t[2] * l0;
-                }
-                *o = [p, pu, pv * k, puu, puv * k, pvv * k2];
+        self.grid_rows(us, vs, 2, |row, col| {
+            let [mut p, mut pu, mut puu] = [row.a[0][0], row.a[1][0], row.a[2][0]];
+            let [mut pv, mut puv, mut pvv] = [Vec3::ZERO; 3];
+            for n in 1..=m {
+                let (c, s) = col.cs[n];
+                let nf = n as f64;
+                let (a0, b0) = (row.a[0][n], row.b[0][n]);
+                let (a1, b1) = (row.a[1][n], row.b[1][n]);
+                let value = a0 * c + b0 * s;
+                p += value;
+                pu += a1 * c + b1 * s;
+                puu += row.a[2][n] * c + row.b[2][n] * s;
+                pv += (b0 * c - a0 * s) * nf;
+                puv += (b1 * c - a1 * s) * nf;
+                pvv -= value * (nf * nf);
             }
-        });
-        out
+            for (ci, t) in col.tails.iter().enumerate() {
+                let (l0, l1, l2) = (row.l[0][ci], row.l[1][ci], row.l[2][ci]);
+                p += t[0] * l0;
+                pu += t[0] * l1;
+                puu += t[0] * l2;
+                pv += t[1] * l0;
+                puv += t[1] * l1;
+                pvv += t[2] * l0;
+            }
+            [p, pu, pv * k, puu, puv * k, pvv * k2]
+        })
     }
 }
 
@@ -513,6 +494,30 @@ struct GridColumn {
 }
 
 impl SpectralPatch {
+    /// The grid `us × vs` (row-major in `u`) of `point(row, column)`: the column data up
+    /// to the `jmax`-th θ-derivative once per `v`, the mode functions up to the `jmax`-th
+    /// u-derivative once per `u`; rows are filled in parallel into one output buffer.
+    fn grid_rows<const D: usize>(
+        &self,
+        us: &[f64],
+        vs: &[f64],
+        jmax: usize,
+        point: impl Fn(&Row, &GridColumn) -> [Vec3; D] + Sync,
+    ) -> Vec<[Vec3; D]> {
+        let cols = self.grid_columns(vs, jmax);
+        let mut out = vec![[Vec3::ZERO; D]; us.len() * vs.len()];
+        if vs.is_empty() {
+            return out;
+        }
+        out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
+            let row = self.row(u, jmax);
+            for (o, col) in dst.iter_mut().zip(&cols) {
+                *o = point(&row, col);
+            }
+        });
+        out
+    }
+
     fn grid_columns(&self, vs: &[f64], jmax: usize) -> Vec<GridColumn> {
         let m = self.opts.modes;
         vs.par_iter()
