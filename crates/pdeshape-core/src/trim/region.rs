@@ -69,6 +69,11 @@ pub struct TrimRegion {
     pub polygons: Vec<Vec<Uv>>,
     /// `+1` when the curve runs counter-clockwise in its parameter, `−1` otherwise.
     pub orientation: Vec<f64>,
+    /// Per curve, twice the largest distance of the curve from its polygon's chords
+    /// (sampled at the chords' parameter midpoints; 0 for a polygon, which is its own
+    /// polygonisation): closer than this to the polygon, [`in_hole`](Self::in_hole)
+    /// judges by the curve itself.
+    pub sagitta: Vec<f64>,
     /// Bridges `(curve a, t_a, curve b, t_b)` joining the curves into one loop.
     pub bridges: Vec<(usize, f64, usize, f64)>,
     /// The loop: every curve once counter-clockwise, every bridge twice.
@@ -95,6 +100,7 @@ impl TrimRegion {
         }
         let mut polygons = Vec::new();
         let mut orientation = Vec::new();
+        let mut sagitta = Vec::new();
         let mut area = domain.area();
         let mut cx = [0.0; 2];
         let mut total = 0.0;
@@ -114,6 +120,7 @@ impl TrimRegion {
             if let Some(at) = self_intersection(&poly) {
                 return Err(TrimError::SelfIntersection { curve: name.clone(), at });
             }
+            let sag = if corners_allowed { 0.0 } else { 2.0 * chord_deviation(c, &pts) };
             let a2 = signed_area2(&poly);
             if a2.abs() < 1e-12 * domain.area() {
                 return Err(TrimError::Degenerate { curve: name.clone() });
@@ -124,6 +131,7 @@ impl TrimRegion {
             cx[1] += c[1] * a2.abs();
             total += a2.abs();
             orientation.push(a2.signum());
+            sagitta.push(sag);
             polygons.push(poly);
         }
         for i in 0..polygons.len() {
@@ -142,8 +150,17 @@ impl TrimRegion {
             }
         }
         let center = [cx[0] / total, cx[1] / total];
-        let mut region =
-            TrimRegion { domain, curves, polygons, orientation, bridges: vec![], pieces: vec![], area, center };
+        let mut region = TrimRegion {
+            domain,
+            curves,
+            polygons,
+            orientation,
+            sagitta,
+            bridges: vec![],
+            pieces: vec![],
+            area,
+            center,
+        };
         region.join()?;
         Ok(region)
     }
@@ -330,15 +347,40 @@ impl TrimRegion {
         d
     }
 
-    /// True when `p` lies inside (or within `tol` of) some trim curve, judged on the fine
-    /// polygonisations.
+    /// True when `p` lies inside (or within `tol` of) some trim curve. Judged on the
+    /// polygonisations, except between a polygon and its curve (closer to the polygon than
+    /// the curve's [`sagitta`](Self::sagitta)), where a chord cuts off or adds a sliver:
+    /// there the side of the curve's tangent at the closest point decides.
     pub fn in_hole(&self, p: Uv, tol: f64) -> bool {
-        self.polygons.iter().any(|poly| inside_polygon(p, poly) || (tol > 0.0 && near_polygon(p, poly, tol)))
+        (0..self.polygons.len()).any(|i| {
+            let poly = &self.polygons[i];
+            let d = super::curve::distance_to_polygon(p, poly);
+            if tol > 0.0 && d < tol {
+                return true;
+            }
+            if d >= self.sagitta[i] {
+                return inside_polygon(p, poly);
+            }
+            let curve = &self.curves[i].1;
+            let (t, _) = curve.closest(p);
+            let c = curve.derivatives(t, 1);
+            let side = cross(c[1], sub(p, c[0])) * self.orientation[i];
+            if side == 0.0 || c[1] == [0.0, 0.0] { inside_polygon(p, poly) } else { side > 0.0 }
+        })
     }
 }
 
-fn near_polygon(p: Uv, poly: &[Uv], tol: f64) -> bool {
-    super::curve::distance_to_polygon(p, poly) < tol
+/// The largest distance of the curve's points at the parameter midpoints of the
+/// polygonisation `pts` from the chords.
+fn chord_deviation(c: &TrimCurve, pts: &[(f64, Uv)]) -> f64 {
+    let n = pts.len();
+    (0..n)
+        .map(|i| {
+            let ((ta, a), (tb, b)) = (pts[i], pts[(i + 1) % n]);
+            let tb = if i + 1 == n { tb + TAU } else { tb };
+            distance_to_segment(c.point(0.5 * (ta + tb)), a, b)
+        })
+        .fold(0.0, f64::max)
 }
 
 fn centroid(p: &[Uv]) -> Uv {

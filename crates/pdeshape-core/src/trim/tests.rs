@@ -343,3 +343,24 @@ fn closest_finds_a_corner_of_a_spline() {
     }
     assert_eq!(c.point(-0.1), c.point(TAU - 0.1), "closed curves wrap");
 }
+
+/// Found by a longer run of `deep_spikes_give_a_valid_mesh_or_an_error`: a ring-1 vertex
+/// at a spike tip lay between the curve and a chord of its polygonisation, inside the hole
+/// but outside the polygon, so the repair never saw it. Between a chord and its arc the
+/// curve itself decides.
+#[test]
+fn points_between_a_chord_and_its_arc_are_judged_by_the_curve() {
+    let (c, r) = ([0.5, 0.5], 0.2);
+    let reg = region(vec![("c", TrimCurve::ellipse(c, [r, r]))]);
+    let n = reg.polygons[0].len();
+    let sag = r * (1.0 - (std::f64::consts::PI / n as f64).cos());
+    assert!(reg.sagitta[0] >= sag);
+    let at = |t: f64, rho: f64| [c[0] + rho * t.cos(), c[1] + rho * t.sin()];
+    for k in [0, 7, n / 3] {
+        let t = TAU * (k as f64 + 0.5) / n as f64;
+        let inner = at(t, r - 0.5 * sag);
+        assert!(!inside_polygon(inner, &reg.polygons[0]) && reg.in_hole(inner, 0.0), "{inner:?}");
+        assert!(!reg.in_hole(at(t, r + 1e-12), 0.0) && reg.in_hole(at(t, r - 1e-12), 0.0));
+        assert!(!reg.in_hole(at(t, r + 2.0 * sag), 0.0) && reg.in_hole(at(t, r - 2.0 * sag), 0.0));
+    }
+}
