@@ -76,6 +76,30 @@ impl FourierSeries {
         s
     }
 
+    /// `out[j] = dʲ/dθʲ` of the series at θ for `j ≤ jmax`, from `cs[n] = (cos nθ, sin nθ)`
+    /// (at least one entry per mode): `dʲ/dθʲ (a cos nθ + b sin nθ) =
+    /// nʲ (a cos(nθ + jπ/2) + b sin(nθ + jπ/2))`, the phase shift taken exactly by
+    /// permuting and negating `cos nθ`, `sin nθ` — one `sin_cos` per mode serves every
+    /// series and every order at that θ.
+    pub fn derivatives_from(&self, cs: &[(f64, f64)], jmax: usize) -> Vec<Vec3> {
+        assert!(cs.len() >= self.a.len(), "cos nθ, sin nθ for every mode");
+        (0..=jmax)
+            .map(|j| {
+                let mut s = if j == 0 { self.a[0] } else { Vec3::ZERO };
+                for (n, ((a, b), &(c, sn))) in self.a.iter().zip(&self.b).zip(cs).enumerate().skip(1) {
+                    let (cj, sj) = match j % 4 {
+                        0 => (c, sn),
+                        1 => (-sn, c),
+                        2 => (-c, -sn),
+                        _ => (sn, -c),
+                    };
+                    s += (*a * cj + *b * sj) * (n as f64).powi(j as i32);
+                }
+                s
+            })
+            .collect()
+    }
+
     /// The series at θ.
     pub fn eval(&self, theta: f64) -> Vec3 {
         self.eval_derivative(theta, 0)

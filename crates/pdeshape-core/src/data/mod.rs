@@ -190,6 +190,12 @@ mod tests {
             for k in 0..20 {
                 let t = 0.31 * k as f64;
                 prop_assert!((s.eval(t) - f(t)).norm() < 1e-12);
+                // all derivatives from one sin_cos per mode = each derivative on its own
+                let cs: Vec<(f64, f64)> = (0..=m).map(|n| (n as f64 * t).sin_cos()).map(|(s, c)| (c, s)).collect();
+                for (j, d) in s.derivatives_from(&cs, 5).into_iter().enumerate() {
+                    let want = s.eval_derivative(t, j);
+                    prop_assert!((d - want).norm() <= 1e-12 * want.norm().max(1.0), "order {}", j);
+                }
             }
         }
     }

@@ -311,15 +311,26 @@ impl SpectralPatch {
         row
     }
 
+    /// `(cos nθ, sin nθ)` for `n = 0 … M`.
+    fn trig(&self, theta: f64) -> Vec<(f64, f64)> {
+        (0..=self.opts.modes).map(|n| (n as f64 * theta).sin_cos()).map(|(s, c)| (c, s)).collect()
+    }
+
     /// `r_i^{(j)}(θ)` for every condition, `j = 0 … jmax` (θ-derivatives).
     fn tails(&self, theta: f64, jmax: usize) -> Vec<Vec<Vec3>> {
+        self.tails_with(theta, &self.trig(theta), jmax)
+    }
+
+    /// [`tails`](Self::tails) with `cs = trig(θ)` given.
+    fn tails_with(&self, theta: f64, cs: &[(f64, f64)], jmax: usize) -> Vec<Vec<Vec3>> {
         let shape = JetShape::new(&[jmax]);
         self.data
             .iter()
             .zip(&self.series)
             .map(|(g, s)| {
                 let jet = g.jet(&[theta, self.time], shape);
-                (0..=jmax).map(|j| jet.derivative([j, 0, 0]) - s.eval_derivative(theta, j)).collect()
+                let series = s.derivatives_from(cs, jmax);
+                (0..=jmax).map(|j| jet.derivative([j, 0, 0]) - series[j]).collect()
             })
             .collect()
     }
@@ -519,14 +530,12 @@ impl SpectralPatch {
     }
 
     fn grid_columns(&self, vs: &[f64], jmax: usize) -> Vec<GridColumn> {
-        let m = self.opts.modes;
         vs.par_iter()
             .map(|&v| {
                 let th = self.theta(v);
-                GridColumn {
-                    cs: (0..=m).map(|n| (n as f64 * th).sin_cos()).map(|(s, c)| (c, s)).collect(),
-                    tails: self.tails(th, jmax),
-                }
+                let cs = self.trig(th);
+                let tails = self.tails_with(th, &cs, jmax);
+                GridColumn { cs, tails }
             })
             .collect()
     }
