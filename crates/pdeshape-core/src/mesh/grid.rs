@@ -121,13 +121,7 @@ impl Mesh {
             }
             _ => {
                 let dom = s.v_domain();
-                self.uvs
-                    .par_iter()
-                    .map(|uv| {
-                        let d = s.derivatives(uv[0], dom.at(uv[1]), 2, 2);
-                        [d[0], d[3], d[1], d[6], d[4], d[2]]
-                    })
-                    .collect()
+                self.uvs.par_iter().map(|uv| s.jet2(uv[0], dom.at(uv[1]))).collect()
             }
         };
         let values = jets.par_iter().map(|j| crate::patch::mean_curvature(j).unwrap_or(0.0)).collect();

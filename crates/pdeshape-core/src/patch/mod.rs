@@ -85,15 +85,14 @@ pub trait Surface: Send + Sync {
     /// to share per-row and per-column work.
     fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
         use rayon::prelude::*;
-        us.par_iter()
-            .flat_map_iter(|&u| {
-                vs.iter().map(move |&v| {
-                    // index i·3 + j of ∂ⁱ_u ∂ʲ_v
-                    let d = self.derivatives(u, v, 2, 2);
-                    [d[0], d[3], d[1], d[6], d[4], d[2]]
-                })
-            })
-            .collect()
+        us.par_iter().flat_map_iter(|&u| vs.iter().map(move |&v| self.jet2(u, v))).collect()
+    }
+
+    /// `[X, X_u, X_v, X_uu, X_uv, X_vv]` at one point (the order of [`grid2`](Self::grid2)).
+    fn jet2(&self, u: f64, v: f64) -> [Vec3; 6] {
+        // index i·3 + j of ∂ⁱ_u ∂ʲ_v
+        let d = self.derivatives(u, v, 2, 2);
+        [d[0], d[3], d[1], d[6], d[4], d[2]]
     }
 
     /// `∂ᵏX/∂uᵏ (u, v)`.
@@ -118,12 +117,11 @@ pub fn mean_curvature(j: &[Vec3; 6]) -> Option<f64> {
     let [_, xu, xv, xuu, xuv, xvv] = *j;
     let n = xu.cross(xv);
     let area2 = n.dot(n);
-    let scale = xu.dot(xu) * xv.dot(xv);
-    if !(area2 > 1e-24 * scale && area2.is_finite()) {
+    let (e, f, g) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
+    if !(area2 > 1e-24 * e * g && area2.is_finite()) {
         return None;
     }
     let n = n * (1.0 / area2.sqrt());
-    let (e, f, g) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
     let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
     Some((e * nn - 2.0 * f * m + g * l) / (2.0 * area2))
 }
