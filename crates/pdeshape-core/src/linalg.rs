@@ -1,6 +1,7 @@
 //! Dense linear algebra on top of `faer`: pivoted factorizations that report their
 //! condition numbers.
 
+use crate::num::MaxNan;
 use faer::Mat;
 use faer::linalg::solvers::{FullPivLu, Solve};
 
@@ -30,7 +31,7 @@ pub fn condition_number(a: &Mat<f64>) -> Result<f64, LinalgError> {
         return Err(LinalgError::NonFinite);
     }
     let s = a.singular_values().map_err(|_| LinalgError::NoConvergence)?;
-    let max = s.iter().cloned().fold(0.0, f64::max);
+    let max = s.iter().cloned().max_nan();
     let min = s.iter().cloned().fold(f64::INFINITY, f64::min);
     Ok(if min > 0.0 { max / min } else { f64::INFINITY })
 }
@@ -85,7 +86,7 @@ pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<
     }
     let svd = a.thin_svd().map_err(|_| LinalgError::NoConvergence)?;
     let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
-    let smax = (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
+    let smax = (0..s.nrows()).map(|i| s[i]).max_nan();
     let mut utb = u.transpose() * b;
     let mut rank = 0;
     for i in 0..s.nrows() {

@@ -1,5 +1,6 @@
 //! A small 3-vector type for points and derivatives in R³.
 
+use crate::num::{max_nan, min_nan};
 use std::ops::{Add, AddAssign, Div, Index, IndexMut, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A vector (or point) in R³.
@@ -61,10 +62,10 @@ impl Vec3 {
         self.dot(self).sqrt()
     }
 
-    /// Largest absolute component (the ∞-norm).
+    /// Largest absolute component (the ∞-norm); NaN when a component is NaN.
     #[inline]
     pub fn max_abs(self) -> f64 {
-        self.x.abs().max(self.y.abs()).max(self.z.abs())
+        max_nan(max_nan(self.x.abs(), self.y.abs()), self.z.abs())
     }
 
     /// The unit vector in the direction of `a`, or `None` for a (numerically) zero vector.
@@ -74,16 +75,17 @@ impl Vec3 {
         (n > 0.0 && n.is_finite()).then(|| self / n)
     }
 
-    /// Componentwise minimum.
+    /// Componentwise minimum (NaN where either component is NaN, so a bounding box of
+    /// points with a NaN is NaN, not the box of the other points).
     #[inline]
     pub fn min(self, o: Vec3) -> Vec3 {
-        Vec3::new(self.x.min(o.x), self.y.min(o.y), self.z.min(o.z))
+        Vec3::new(min_nan(self.x, o.x), min_nan(self.y, o.y), min_nan(self.z, o.z))
     }
 
-    /// Componentwise maximum.
+    /// Componentwise maximum (NaN where either component is NaN).
     #[inline]
     pub fn max(self, o: Vec3) -> Vec3 {
-        Vec3::new(self.x.max(o.x), self.y.max(o.y), self.z.max(o.z))
+        Vec3::new(max_nan(self.x, o.x), max_nan(self.y, o.y), max_nan(self.z, o.z))
     }
 
     /// True when all three components are finite.
@@ -185,5 +187,15 @@ impl IndexMut<usize> for Vec3 {
 impl std::iter::Sum for Vec3 {
     fn sum<I: Iterator<Item = Vec3>>(iter: I) -> Vec3 {
         iter.fold(Vec3::ZERO, |a, b| a + b)
+    }
+}
+
+impl std::fmt::Display for Vec3 {
+    /// `(x, y, z)`, each component as `f64` prints (precision passes through: `{:.3}`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match f.precision() {
+            Some(p) => write!(f, "({:.p$}, {:.p$}, {:.p$})", self.x, self.y, self.z),
+            None => write!(f, "({}, {}, {})", self.x, self.y, self.z),
+        }
     }
 }

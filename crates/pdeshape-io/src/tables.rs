@@ -92,7 +92,7 @@ fn max_distance(a: &dyn Surface, b: &dyn Surface) -> f64 {
     for i in 0..100 {
         for j in 0..100 {
             let (u, v) = (i as f64 / 99.0, dom.at(j as f64 / 99.0));
-            worst = worst.max((a.point(u, v) - b.point(u, v)).norm());
+            worst = pdeshape_core::num::max_nan(worst, (a.point(u, v) - b.point(u, v)).norm());
         }
     }
     worst

@@ -24,10 +24,10 @@ pub struct Gaps {
 }
 
 impl Gaps {
-    /// Entry-wise maximum.
+    /// Entry-wise maximum (NaN when either is NaN).
     pub fn max(self, o: Gaps) -> Gaps {
         let m = |a: Option<f64>, b: Option<f64>| match (a, b) {
-            (Some(x), Some(y)) => Some(x.max(y)),
+            (Some(x), Some(y)) => Some(crate::num::max_nan(x, y)),
             (x, None) => x,
             (None, y) => y,
         };

@@ -1,6 +1,7 @@
 use super::*;
 use crate::Vec3;
 use crate::data::{ExprField, FieldRef};
+use crate::num::MaxNan;
 use crate::patch::{Condition, Surface, VDomain, check_conditions};
 use proptest::prelude::*;
 use std::sync::Arc;
@@ -41,9 +42,9 @@ fn max_residual(b: &StaticBlend) -> (f64, f64) {
     for i in 0..40 {
         let (u, v) = ((i as f64 * 0.618).fract(), (i as f64 * 2.39).rem_euclid(std::f64::consts::TAU));
         let r = b.residual(u, v);
-        worst = worst.max(r.norm());
+        worst = crate::num::max_nan(worst, r.norm());
         let d = b.derivatives(u, v, 6, 0);
-        size = size.max(d.iter().map(|x| x.norm()).fold(0.0, f64::max));
+        size = crate::num::max_nan(size, d.iter().map(|x| x.norm()).max_nan());
     }
     (worst, size)
 }
@@ -56,7 +57,7 @@ fn condition_error(b: &StaticBlend, conds: &[Condition]) -> f64 {
             for i in 0..1000 {
                 let v = std::f64::consts::TAU * (i as f64 + 0.3) / 1000.0;
                 let x = b.u_derivative(c.u, v, c.order)[t];
-                worst = worst.max((x - c.data.eval(&[v, 0.0])[t]).abs());
+                worst = crate::num::max_nan(worst, (x - c.data.eval(&[v, 0.0])[t]).abs());
             }
         }
     }
@@ -223,7 +224,7 @@ proptest! {
         let b = StaticBlend::new(ops, &conds, VDomain::PERIODIC, &BlendOptions::default()).unwrap();
         prop_assert!(b.reports().iter().all(|r| r.solver == "exact"));
         let err = condition_error(&b, &conds);
-        let size = conds.iter().map(|c| (0..50).map(|i| c.data.eval(&[i as f64 * 0.13, 0.0]).norm()).fold(0.0, f64::max)).fold(1.0, f64::max);
+        let size = conds.iter().map(|c| (0..50).map(|i| c.data.eval(&[i as f64 * 0.13, 0.0]).norm()).max_nan()).fold(1.0, f64::max);
         prop_assert!(err < 1e-10 * size, "condition error {}", err);
         let (res, rsize) = max_residual(&b);
         prop_assert!(res < 1e-10 * rsize.max(1.0), "PDE residual {} of {}", res, rsize);

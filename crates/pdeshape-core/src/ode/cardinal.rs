@@ -2,6 +2,7 @@
 
 use super::ExpSpace;
 use crate::linalg::{LinalgError, SquareSolver};
+use crate::num::MaxNan;
 use faer::Mat;
 
 /// A condition `y^{(order)}(u) = …` of the boundary-value problem.
@@ -117,7 +118,7 @@ impl Cardinal {
     /// the conditions.
     pub fn lebesgue(&self, samples: usize) -> f64 {
         let pts = (0..=samples).map(|k| k as f64 / samples as f64).chain(self.conds.iter().map(|c| c.u));
-        pts.map(|u| self.eval(u, 0)[0].iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+        pts.map(|u| self.eval(u, 0)[0].iter().map(|x| x.abs()).sum::<f64>()).max_nan()
     }
 }
 

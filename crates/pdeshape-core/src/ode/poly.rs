@@ -207,7 +207,7 @@ mod tests {
             for b in 0..space.dim() {
                 let acc: f64 = c.iter().enumerate().map(|(k, ck)| ck * d[k][b]).sum();
                 let size: f64 = c.iter().enumerate().map(|(k, ck)| (ck * d[k][b]).abs()).sum();
-                worst = worst.max(acc.abs() / size.max(1e-300));
+                worst = crate::num::max_nan(worst, acc.abs() / size.max(1e-300));
             }
         }
         worst

@@ -9,6 +9,7 @@
 //! turned into Chebyshev series; everything after that is f64 (Clenshaw summation).
 
 use super::{CondSpec, ExpSpace, OdeError};
+use crate::num::MaxNan;
 use astro_float::{BigFloat, Consts, RoundingMode, Sign};
 
 const RM: RoundingMode = RoundingMode::ToEven;
@@ -119,6 +120,7 @@ fn mp_inverse(a: Vec<Vec<BigFloat>>, p: usize) -> Option<Vec<Vec<BigFloat>>> {
         })
         .collect();
     for col in 0..n {
+        crate::cancel::checkpoint();
         let piv = (col..n)
             .max_by(|&x, &y| m[x][col].abs_cmp(&m[y][col]).map(|s| s.cmp(&0)).unwrap_or(std::cmp::Ordering::Equal))?;
         if m[piv][col].is_zero() {
@@ -163,7 +165,7 @@ impl ChebCardinal {
     /// derivatives up to `kmax`.
     pub fn new(space: &ExpSpace, conds: &[CondSpec], kmax: usize) -> Result<Self, OdeError> {
         let n = space.dim();
-        let c = space.roots().iter().map(|r| r.re.abs()).fold(0.0, f64::max);
+        let c = space.roots().iter().map(|r| r.re.abs()).max_nan();
         let dmax = conds.iter().map(|c| c.order).max().unwrap_or(0);
         let mut cc = Consts::new().map_err(|e| OdeError::Singular { cond: f64::NAN, detail: format!(": {e:?}") })?;
         let mut bits = 256usize;
@@ -173,7 +175,7 @@ impl ChebCardinal {
             let Some(inv) = mp_inverse(rows, bits) else {
                 return Err(OdeError::Singular { cond: f64::INFINITY, detail: String::new() });
             };
-            let max_inv = inv.iter().flatten().map(|x| to_f64(x).abs()).fold(0.0, f64::max);
+            let max_inv = inv.iter().flatten().map(|x| to_f64(x).abs()).max_nan();
             let need = (max_inv.max(1.0).log2().ceil() as usize) + 80;
             if !max_inv.is_finite() || max_inv > 1e300 {
                 return Err(OdeError::Singular { cond: max_inv, detail: String::new() });
@@ -200,6 +202,7 @@ impl ChebCardinal {
                 // vals[k][i][j] = ℓ_i^{(k)}(node_j)
                 let mut vals = vec![vec![vec![0.0; deg + 1]; n]; kmax + 1];
                 for (j, &x) in nodes.iter().enumerate() {
+                    crate::cancel::checkpoint();
                     let d = mp_derivatives(space, x, kmax, bits, &mut cc);
                     for (k, row) in d.iter().enumerate() {
                         for i in 0..n {

@@ -1,6 +1,7 @@
 //! Choosing between f64 and multiple-precision cardinal functions.
 
 use super::{Cardinal, ChebCardinal, CondSpec, ExpSpace, OdeError};
+use crate::num::MaxNan;
 
 /// Condition number below which the f64 solve is used directly.
 pub const F64_COND_LIMIT: f64 = 1e4;
@@ -64,8 +65,6 @@ impl CardinalSet {
 
     /// `max_u Σ_i |ℓ_i(u)|` on `samples + 1` equispaced points.
     pub fn lebesgue(&self, samples: usize) -> f64 {
-        (0..=samples)
-            .map(|k| self.eval(k as f64 / samples as f64, 0)[0].iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
+        (0..=samples).map(|k| self.eval(k as f64 / samples as f64, 0)[0].iter().map(|x| x.abs()).sum::<f64>()).max_nan()
     }
 }

@@ -1,5 +1,6 @@
 //! The solution space of `P(D) y = 0` with a bounded, well-conditioned basis.
 
+use crate::num::MaxNan;
 use num_complex::Complex64;
 
 /// A root of the characteristic polynomial with its multiplicity. Complex roots are given
@@ -80,7 +81,7 @@ fn clusters(roots: &[Root]) -> Vec<Vec<usize>> {
 fn cluster_derivatives(c: Complex64, delta: &[Complex64], w: f64, kmax: usize) -> Vec<Vec<Complex64>> {
     let zero = Complex64::new(0.0, 0.0);
     let m = delta.len();
-    let radius = delta.iter().map(|d| d.norm()).fold(0.0, f64::max) * w.abs().max(1e-300);
+    let radius = delta.iter().map(|d| d.norm()).max_nan() * w.abs().max(1e-300);
     let mut tail = 1usize;
     let mut term = radius;
     while term > 1e-18 && tail < 400 {
@@ -293,7 +294,7 @@ mod tests {
                 let scale = p.iter().enumerate().map(|(j, c)| (c * d[j][b]).abs()).fold(1e-300, f64::max);
                 acc.abs() / scale
             })
-            .fold(0.0, f64::max)
+            .max_nan()
     }
 
     fn cond(k: ExpSpace) -> f64 {

@@ -4,6 +4,7 @@
 
 use super::TrimError;
 use super::curve::{TrimCurve, Uv, cross, distance_to_segment, inside_polygon, segments_intersect, signed_area2, sub};
+use crate::num::MaxNan;
 use std::f64::consts::TAU;
 
 /// The parameter rectangle `[u₀, u₁] × [v₀, v₁]`.
@@ -380,7 +381,7 @@ fn chord_deviation(c: &TrimCurve, pts: &[(f64, Uv)]) -> f64 {
             let tb = if i + 1 == n { tb + TAU } else { tb };
             distance_to_segment(c.point(0.5 * (ta + tb)), a, b)
         })
-        .fold(0.0, f64::max)
+        .max_nan()
 }
 
 fn centroid(p: &[Uv]) -> Uv {

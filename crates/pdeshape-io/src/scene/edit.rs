@@ -1,0 +1,208 @@
+//! Edits of the scene text (the editor's sliders, handles and trim edits): set, insert or
+//! delete a value at a path of
+//! table keys and array indices, applied with `toml_edit` so the rest of the file (comments,
+//! layout) is kept; and the editable items the page shows (curve control points, trims).
+
+use serde::Deserialize;
+use serde_json::{Value, json};
+use toml_edit::{DocumentMut, Item, Value as TValue};
+
+/// One path segment: a table key or an array index.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Seg {
+    /// Table key.
+    Key(String),
+    /// Array index.
+    Index(usize),
+}
+
+/// An edit of the scene text.
+#[derive(Clone, Debug, Deserialize)]
+pub struct Edit {
+    /// `set` (default), `insert` (before the index) or `delete`.
+    #[serde(default)]
+    pub op: Option<String>,
+    /// Path to the value.
+    pub path: Vec<Seg>,
+    /// New value (numbers or arrays of numbers) for `set` and `insert`.
+    #[serde(default)]
+    pub value: Value,
+}
+
+fn to_toml(v: &Value) -> Result<TValue, String> {
+    match v {
+        // integers stay integers (`resolution`, `modes`, `degree` take only integers)
+        Value::Number(n) if n.is_i64() => Ok(TValue::from(n.as_i64().expect("checked"))),
+        Value::Number(n) => {
+            let x = n.as_f64().ok_or("not a number")?;
+            if !x.is_finite() {
+                return Err("a value is not finite".into());
+            }
+            Ok(TValue::from(x))
+        }
+        Value::Array(a) => {
+            let mut arr = toml_edit::Array::new();
+            for x in a {
+                arr.push(to_toml(x)?);
+            }
+            Ok(TValue::Array(arr))
+        }
+        Value::String(s) => Ok(TValue::from(s.as_str())),
+        _ => Err(format!("cannot put {v} into a scene file")),
+    }
+}
+
+fn path_text(path: &[Seg]) -> String {
+    path.iter()
+        .map(|s| match s {
+            Seg::Key(k) => format!(".{k}"),
+            Seg::Index(i) => format!("[{i}]"),
+        })
+        .collect::<String>()
+        .trim_start_matches('.')
+        .to_string()
+}
+
+/// Applies the edits in order; errors name the path.
+pub fn apply(text: &str, edits: &[Edit]) -> Result<String, String> {
+    if edits.is_empty() {
+        return Ok(text.to_string());
+    }
+    let mut doc: DocumentMut = text.parse().map_err(|e| format!("scene text: {e}"))?;
+    for e in edits {
+        let where_ = path_text(&e.path);
+        let (last, parents) = e.path.split_last().ok_or("an edit needs a path")?;
+        let mut item: &mut Item = doc.as_item_mut();
+        for seg in parents {
+            let missing = || format!("edit {where_}: no such entry `{}`", path_text(std::slice::from_ref(seg)));
+            let exists = match seg {
+                Seg::Key(k) => item.get(k.as_str()).is_some_and(|x| !x.is_none()),
+                Seg::Index(i) => item.get(*i).is_some_and(|x| !x.is_none()),
+            };
+            if !exists {
+                return Err(missing());
+            }
+            item = match seg {
+                Seg::Key(k) => item.get_mut(k.as_str()),
+                Seg::Index(i) => item.get_mut(*i),
+            }
+            .ok_or_else(missing)?;
+        }
+        let op = e.op.as_deref().unwrap_or("set");
+        match (op, last) {
+            ("set", Seg::Key(k)) => {
+                let v = to_toml(&e.value).map_err(|m| format!("edit {where_}: {m}"))?;
+                let t = item.as_table_like_mut().ok_or_else(|| format!("edit {where_}: not inside a table"))?;
+                t.insert(k, Item::Value(v));
+            }
+            (op, Seg::Index(i)) => {
+                let arr = item.as_array_mut().ok_or_else(|| format!("edit {where_}: not inside an array"))?;
+                match op {
+                    "set" if *i < arr.len() => {
+                        let v = to_toml(&e.value).map_err(|m| format!("edit {where_}: {m}"))?;
+                        arr.replace(*i, v);
+                    }
+                    "insert" if *i <= arr.len() => {
+                        let v = to_toml(&e.value).map_err(|m| format!("edit {where_}: {m}"))?;
+                        arr.insert(*i, v);
+                    }
+                    "delete" if *i < arr.len() => {
+                        arr.remove(*i);
+                    }
+                    _ => return Err(format!("edit {where_}: `{op}` at index {i} of an array of {}", arr.len())),
+                }
+            }
+            (op, _) => return Err(format!("edit {where_}: unknown operation `{op}`")),
+        }
+    }
+    Ok(doc.to_string())
+}
+
+fn numbers(v: &TValue) -> Option<Vec<f64>> {
+    let a = v.as_array()?;
+    a.iter().map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect()
+}
+
+fn point_list(item: Option<&Item>, dim: usize) -> Option<Vec<Vec<f64>>> {
+    let arr = item?.as_array()?;
+    arr.iter().map(|p| numbers(p).filter(|v| v.len() == dim)).collect()
+}
+
+/// Draggable items of the scene text: control points of `bspline`/`polyline` curves (3D)
+/// and of trim curves (`bspline`/`polygon` in (u, v), circle centres).
+pub fn editables(text: &str) -> Value {
+    let Ok(doc) = text.parse::<DocumentMut>() else { return json!({"handles": [], "trims": []}) };
+    let mut handles = Vec::new();
+    if let Some(curves) = doc.get("curves").and_then(|c| c.as_table_like()) {
+        for (name, c) in curves.iter() {
+            for key in ["bspline", "polyline"] {
+                if let Some(pts) = point_list(c.get(key), 3) {
+                    for (i, p) in pts.iter().enumerate() {
+                        handles
+                            .push(json!({"curve": name, "index": i, "position": p, "path": ["curves", name, key, i]}));
+                    }
+                }
+            }
+        }
+    }
+    let mut trims = Vec::new();
+    if let Some(patches) = doc.get("patches").and_then(|c| c.as_table_like()) {
+        for (pname, p) in patches.iter() {
+            let Some(curves) = p.get("trim").and_then(|t| t.get("curves")).and_then(|c| c.as_table_like()) else {
+                continue;
+            };
+            for (cname, c) in curves.iter() {
+                for key in ["bspline", "polygon"] {
+                    if let Some(pts) = point_list(c.get(key), 2) {
+                        trims.push(json!({"patch": pname, "curve": cname, "kind": key, "points": pts,
+                            "path": ["patches", pname, "trim", "curves", cname, key]}));
+                    }
+                }
+                if let Some(center) =
+                    c.get("circle").and_then(|ci| ci.get("center")).and_then(|x| x.as_value()).and_then(numbers)
+                {
+                    trims.push(json!({"patch": pname, "curve": cname, "kind": "circle", "points": [center],
+                        "path": ["patches", pname, "trim", "curves", cname, "circle", "center"]}));
+                }
+            }
+        }
+    }
+    json!({"handles": handles, "trims": trims})
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn edit(op: &str, path: Value, value: Value) -> Edit {
+        serde_json::from_value(json!({"op": op, "path": path, "value": value})).unwrap()
+    }
+
+    #[test]
+    fn edits_keep_comments_and_reach_nested_arrays() {
+        let text = "# top\n[curves.c]\nbspline = [[0, 0, 0], [1, 0, 0], [1, 1, 0]] # pts\n";
+        let out = apply(text, &[edit("set", json!(["curves", "c", "bspline", 1]), json!([2.5, 0, 0]))]).unwrap();
+        assert!(out.contains("# top") && out.contains("2.5"), "{out}");
+        let out = apply(&out, &[edit("insert", json!(["curves", "c", "bspline", 0]), json!([9, 9, 9]))]).unwrap();
+        let out = apply(&out, &[edit("delete", json!(["curves", "c", "bspline", 3]), Value::Null)]).unwrap();
+        let h = editables(&out)["handles"].clone();
+        assert_eq!(h.as_array().unwrap().len(), 3);
+        assert_eq!(h[0]["position"], json!([9.0, 9.0, 9.0]));
+        let e = apply(text, &[edit("set", json!(["curves", "d", "bspline", 0]), json!([0, 0, 0]))]).unwrap_err();
+        assert!(e.contains("no such entry `d`"), "{e}");
+        let e = apply(text, &[edit("delete", json!(["curves", "c", "bspline", 7]), Value::Null)]).unwrap_err();
+        assert!(e.contains("index 7 of an array of 3"), "{e}");
+    }
+
+    /// Regression: JSON integers became TOML floats, so editing `resolution` (integers
+    /// only) always failed.
+    #[test]
+    fn integers_stay_integers() {
+        let text = "[patches.p]\nresolution = [10, 10]\n";
+        let out = apply(text, &[edit("set", json!(["patches", "p", "resolution"]), json!([20, 30]))]).unwrap();
+        assert!(out.contains("resolution = [20, 30]"), "{out}");
+        let out = apply(text, &[edit("set", json!(["patches", "p", "a"]), json!(1.5))]).unwrap();
+        assert!(out.contains("a = 1.5"), "{out}");
+    }
+}
