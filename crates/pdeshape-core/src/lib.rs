@@ -17,12 +17,14 @@
 #![warn(missing_docs)]
 
 pub mod blend;
+pub mod cancel;
 pub mod data;
 pub mod expr;
 pub mod jet;
 pub mod limits;
 pub mod linalg;
 pub mod mesh;
+pub mod num;
 pub mod ode;
 pub mod patch;
 pub mod solid;

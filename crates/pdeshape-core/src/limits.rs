@@ -27,13 +27,15 @@ pub enum Cap {
     Collocation,
     /// Mesh vertices (or solid cells) per patch.
     Vertices,
-    /// Estimated memory of the model's meshes, MiB.
+    /// Estimated memory of the model's meshes and of a solver's dense matrices, MiB.
     Memory,
+    /// Size of a scene file, MiB.
+    Scene,
 }
 
 impl Cap {
     /// Every cap, in the order of [`Cap::name`]'s list.
-    pub const ALL: [Cap; 5] = [Cap::Order, Cap::Modes, Cap::Collocation, Cap::Vertices, Cap::Memory];
+    pub const ALL: [Cap; 6] = [Cap::Order, Cap::Modes, Cap::Collocation, Cap::Vertices, Cap::Memory, Cap::Scene];
 
     /// The name used by `--limit NAME=VALUE`.
     pub fn name(self) -> &'static str {
@@ -43,12 +45,13 @@ impl Cap {
             Cap::Collocation => "collocation",
             Cap::Vertices => "vertices",
             Cap::Memory => "memory",
+            Cap::Scene => "scene",
         }
     }
 
     fn unit(self) -> &'static str {
         match self {
-            Cap::Memory => " MiB",
+            Cap::Memory | Cap::Scene => " MiB",
             _ => "",
         }
     }
@@ -72,7 +75,7 @@ pub struct LimitError {
 }
 
 /// The caps in force. Defaults: order 64, modes 512, collocation 250 000 points,
-/// vertices 4 000 000 per patch, memory 4096 MiB.
+/// vertices 4 000 000 per patch, memory 4096 MiB, scene files 16 MiB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     /// Largest PDE order `2N`.
@@ -83,13 +86,16 @@ pub struct Limits {
     pub collocation: usize,
     /// Largest number of mesh vertices (or solid cells) of one patch.
     pub vertices: usize,
-    /// Largest estimated memory of all meshes of a model, MiB.
+    /// Largest estimated memory of all meshes of a model, and of one solver's dense
+    /// matrices, MiB.
     pub memory: usize,
+    /// Largest scene file, MiB.
+    pub scene: usize,
 }
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { order: 64, modes: 512, collocation: 250_000, vertices: 4_000_000, memory: 4096 }
+        Limits { order: 64, modes: 512, collocation: 250_000, vertices: 4_000_000, memory: 4096, scene: 16 }
     }
 }
 
@@ -102,6 +108,7 @@ impl Limits {
             Cap::Collocation => self.collocation,
             Cap::Vertices => self.vertices,
             Cap::Memory => self.memory,
+            Cap::Scene => self.scene,
         }
     }
 
@@ -113,6 +120,7 @@ impl Limits {
             Cap::Collocation => self.collocation = value,
             Cap::Vertices => self.vertices = value,
             Cap::Memory => self.memory = value,
+            Cap::Scene => self.scene = value,
         }
     }
 
@@ -124,17 +132,29 @@ impl Limits {
         if value > limit as u128 { Err(LimitError { cap, what: what.to_string(), value, limit }) } else { Ok(()) }
     }
 
+    /// `Ok` when a working set of `bytes` fits the `memory` cap (rounded up to whole MiB);
+    /// the solvers call it with the size of their dense matrices before allocating them.
+    pub fn check_bytes(&self, bytes: u128, what: &str) -> Result<(), LimitError> {
+        self.check(Cap::Memory, bytes.div_ceil(1 << 20), what)
+    }
+
     /// Applies one `NAME=VALUE` setting (`--limit`).
     pub fn apply(&mut self, setting: &str) -> Result<(), String> {
         let known = || Cap::ALL.iter().map(|c| c.name()).collect::<Vec<_>>().join(", ");
         let (name, value) =
             setting.split_once('=').ok_or_else(|| format!("`{setting}`: expected NAME=VALUE (names: {})", known()))?;
         let cap = Cap::from_str(name.trim())?;
-        let value: usize = value
-            .trim()
-            .replace('_', "")
-            .parse()
-            .map_err(|_| format!("`{setting}`: {} is not a whole number", value.trim()))?;
+        let digits = value.trim().replace('_', "");
+        let value: usize = digits.parse().map_err(|e: std::num::ParseIntError| {
+            use std::num::IntErrorKind::*;
+            match e.kind() {
+                PosOverflow => format!(
+                    "`{setting}`: {digits} is larger than the largest cap this machine can hold ({})",
+                    usize::MAX
+                ),
+                _ => format!("`{setting}`: {} is not a whole number", value.trim()),
+            }
+        })?;
         self.set(cap, value);
         Ok(())
     }
@@ -168,6 +188,11 @@ mod tests {
         assert!(l.apply("order").unwrap_err().contains("NAME=VALUE"));
         assert!(l.apply("colour=3").unwrap_err().contains("unknown cap `colour`"));
         assert!(l.apply("modes=-1").unwrap_err().contains("not a whole number"));
+        // regression: an overflowing value was called "not a whole number"
+        let e = l.apply("vertices=18446744073709551616").unwrap_err();
+        assert!(e.contains("larger than the largest cap"), "{e}");
+        l.apply("scene=2").unwrap();
+        assert_eq!(l.scene, 2);
         let e = l.check(Cap::Memory, 5000u32, "the meshes' estimated memory").unwrap_err();
         assert_eq!(
             e.to_string(),

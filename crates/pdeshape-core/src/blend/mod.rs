@@ -44,6 +44,9 @@ pub enum BlendError {
     /// The solve failed.
     #[error("solver: {0}")]
     Solver(String),
+    /// The solve would need more memory than the cap allows.
+    #[error(transparent)]
+    Limit(#[from] crate::limits::LimitError),
 }
 
 #[cfg(test)]

@@ -46,11 +46,27 @@ pub struct BlendOptions {
     pub collocation: Option<(usize, usize)>,
     /// An explicit boundary basis, or `None` to extract one automatically.
     pub basis: Option<Vec<BasisFn>>,
+    /// Caps; the solver checks the memory of its dense matrices against `limits.memory`
+    /// before allocating them.
+    pub limits: crate::limits::Limits,
+}
+
+/// Bytes of the dense least-squares solve of an `rows × cols` system: the matrix, the
+/// copy the singular values (condition number) work on, the pivoted QR's copy, and the
+/// right-hand sides and residuals (`rhs` columns each).
+pub fn least_squares_bytes(rows: usize, cols: usize, rhs: usize) -> u128 {
+    8 * rows as u128 * (3 * cols as u128 + 2 * rhs as u128)
 }
 
 impl Default for BlendOptions {
     fn default() -> Self {
-        BlendOptions { solver: Solver::Auto, bubbles: 8, collocation: None, basis: None }
+        BlendOptions {
+            solver: Solver::Auto,
+            bubbles: 8,
+            collocation: None,
+            basis: None,
+            limits: crate::limits::Limits::default(),
+        }
     }
 }
 
@@ -329,9 +345,17 @@ fn solve_collocation(
     let ud: Vec<(Table, Table)> = us.iter().map(|&u| (herm.eval(u, k), bubbles(r, nb, u, k))).collect();
     let coef = op.coefficients();
     let rows = nl * nq;
+    opts.limits.check_bytes(
+        least_squares_bytes(rows, nj * nb, 1),
+        &format!(
+            "component {axis}: the collocation system ({rows} rows × {} unknowns, {nj} basis functions × {nb} bubbles)",
+            nj * nb
+        ),
+    )?;
     let mut a = Mat::<f64>::zeros(rows, nj * nb);
     let mut b = Mat::<f64>::zeros(rows, 1);
     for (l, (h, bub)) in ud.iter().enumerate() {
+        crate::cancel::checkpoint();
         for (q, g) in gd.iter().enumerate() {
             let row = l * nq + q;
             let mut known = 0.0;
@@ -409,6 +433,7 @@ impl Surface for StaticBlend {
             .collect();
         us.par_iter()
             .flat_map_iter(|&u| {
+                crate::cancel::checkpoint();
                 let row: [Vec<Vec<f64>>; 3] =
                     std::array::from_fn(|t| self.comps[t].profiles.iter().map(|p| p.eval(u, 1)).collect());
                 cols.iter()

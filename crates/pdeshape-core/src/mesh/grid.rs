@@ -64,6 +64,7 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
         .zip(flat.par_chunks(o.nv))
         .enumerate()
         .flat_map_iter(|(i, (dst, row))| {
+            crate::cancel::checkpoint();
             let mut gone = Vec::new();
             for (j, (nm, d)) in dst.iter_mut().zip(row).enumerate() {
                 let [_, pu, pv, puv] = *d;

@@ -72,6 +72,7 @@ pub trait Surface: Send + Sync {
         use rayon::prelude::*;
         us.par_iter()
             .flat_map_iter(|&u| {
+                crate::cancel::checkpoint();
                 vs.iter().map(move |&v| {
                     let d = self.derivatives(u, v, 1, 1);
                     [d[0], d[2], d[1], d[3]]
@@ -85,7 +86,12 @@ pub trait Surface: Send + Sync {
     /// to share per-row and per-column work.
     fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
         use rayon::prelude::*;
-        us.par_iter().flat_map_iter(|&u| vs.iter().map(move |&v| self.jet2(u, v))).collect()
+        us.par_iter()
+            .flat_map_iter(|&u| {
+                crate::cancel::checkpoint();
+                vs.iter().map(move |&v| self.jet2(u, v))
+            })
+            .collect()
     }
 
     /// `[X, X_u, X_v, X_uu, X_uv, X_vv]` at one point (the order of [`grid2`](Self::grid2)).
@@ -152,7 +158,7 @@ pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: u
             let x = s.u_derivative(c.u, v, c.order);
             let g = c.data.eval(&[v, t]);
             let e = (x - g).norm();
-            max_abs = if e.is_nan() { f64::NAN } else { max_abs.max(e) };
+            max_abs = crate::num::max_nan(max_abs, e);
             if c.order == 0 {
                 lo = lo.min(x);
                 hi = hi.max(x);
@@ -164,6 +170,7 @@ pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: u
             hi = hi.max(p);
         }
     }
-    let size = (hi - lo).norm().max(f64::MIN_POSITIVE);
+    // NaN stays NaN (a NaN sample makes the box NaN); a zero size becomes the tiniest
+    let size = crate::num::max_nan((hi - lo).norm(), f64::MIN_POSITIVE);
     ConditionReport { max_abs, max_rel: max_abs / size, size }
 }

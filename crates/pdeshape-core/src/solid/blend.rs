@@ -4,6 +4,7 @@ use super::{SolidError, gauss_legendre};
 use crate::Vec3;
 use crate::data::FieldRef;
 use crate::jet::JetShape;
+use crate::num::MaxNan;
 use crate::patch::cubic_hermite;
 use faer::Mat;
 use rayon::prelude::*;
@@ -159,7 +160,7 @@ impl SolidBlend {
             Trial::Galerkin => s.solve_separated(true)?,
             Trial::Paper | Trial::Collocation => s.solve_collocation()?,
         }
-        s.report.max_coefficient = s.a.iter().map(|x| x.x.abs().max(x.y.abs()).max(x.z.abs())).fold(0.0, f64::max);
+        s.report.max_coefficient = s.a.iter().map(|x| x.x.abs().max(x.y.abs()).max(x.z.abs())).max_nan();
         Ok(s)
     }
 
@@ -204,11 +205,17 @@ impl SolidBlend {
         // u, v: ∫∫ R_f sin lπu sin mπv
         let (xu, wu) = gauss_legendre(qu);
         let (xv, wv) = gauss_legendre(qv);
-        let rf: Vec<Vec<[Vec3; 4]>> =
-            xu.par_iter().map(|&u| xv.iter().map(|&v| self.face_residuals(u, v)).collect()).collect();
+        let rf: Vec<Vec<[Vec3; 4]>> = xu
+            .par_iter()
+            .map(|&u| {
+                crate::cancel::checkpoint();
+                xv.iter().map(|&v| self.face_residuals(u, v)).collect()
+            })
+            .collect();
         let mut cond: f64 = 1.0;
         self.report.method = if galerkin { "galerkin" } else { "least-squares" };
         for l in 0..nl {
+            crate::cancel::checkpoint();
             let su: Vec<f64> = xu.iter().map(|&u| ((l + 1) as f64 * PI * u).sin()).collect();
             for m in 0..nm {
                 let sv: Vec<f64> = xv.iter().map(|&v| ((m + 1) as f64 * PI * v).sin()).collect();
@@ -265,6 +272,7 @@ impl SolidBlend {
         let mut b = Mat::<f64>::zeros(k, 3);
         let mut row = 0;
         for &u in &pu {
+            crate::cancel::checkpoint();
             for &v in &pv {
                 let rf = self.face_residuals(u, v);
                 for &w in &pw {
@@ -380,6 +388,7 @@ impl SolidBlend {
         let sv: Vec<Vec<f64>> = vs.iter().map(|&v| (1..=nm).map(|m| (m as f64 * PI * v).sin()).collect()).collect();
         us.par_iter()
             .flat_map_iter(|&u| {
+                crate::cancel::checkpoint();
                 let su: Vec<f64> = (1..=nl).map(|l| (l as f64 * PI * u).sin()).collect();
                 let mut out = Vec::with_capacity(vs.len() * ws.len());
                 for (j, &v) in vs.iter().enumerate() {
@@ -472,7 +481,7 @@ pub(crate) mod tests {
                 let (u, v) = (i as f64 / 49.0, j as f64 / 49.0);
                 for (w, k, face) in [(0.0, 0, 0), (0.0, 1, 1), (1.0, 0, 2), (1.0, 1, 3)] {
                     let d = s.derivatives(u, v, w, 0, 0, 1)[k];
-                    worst = worst.max((d - f[face].eval(&[u, v])).norm());
+                    worst = crate::num::max_nan(worst, (d - f[face].eval(&[u, v])).norm());
                 }
             }
         }
@@ -509,10 +518,8 @@ pub(crate) mod tests {
         };
         let eval = |s: &SolidBlend| pts.iter().map(|&(u, v, w)| s.point(u, v, w)).collect::<Vec<_>>();
         let runs: Vec<Vec<Vec3>> = [3, 6, 9, 12].iter().map(|&n| eval(&sol(n))).collect();
-        let changes: Vec<f64> = runs
-            .windows(2)
-            .map(|w| w[0].iter().zip(&w[1]).map(|(a, b)| (*a - *b).norm()).fold(0.0, f64::max))
-            .collect();
+        let changes: Vec<f64> =
+            runs.windows(2).map(|w| w[0].iter().zip(&w[1]).map(|(a, b)| (*a - *b).norm()).max_nan()).collect();
         assert!(changes[0] > changes[1] && changes[1] > changes[2], "{changes:?}");
         assert!(changes[0] < 0.12 && changes[1] < 0.01 && changes[2] < 0.002, "{changes:?}");
         // the least-squares solid does not fold; Galerkin converges to a different, folding one

@@ -27,6 +27,7 @@ use crate::Vec3;
 use crate::data::fourier::{FourierSeries, sample_count};
 use crate::data::{EvenExtension, FieldRef};
 use crate::jet::JetShape;
+use crate::num::MaxNan;
 use crate::ode::{CardinalSet, CondSpec, ExpSpace, OdeError};
 use crate::patch::{Condition, Surface, VDomain};
 use rayon::prelude::*;
@@ -167,7 +168,14 @@ impl SpectralPatch {
         let n = conds.len() / 2;
         let omega = opts.omega.unwrap_or(opts.a * (opts.modes + 1) as f64);
         if !(omega.is_finite() && omega > 0.0) {
-            return Err(SpectralError::Options(format!("the remainder rate ω = {omega} must be positive")));
+            return Err(SpectralError::Options(match opts.omega {
+                Some(w) => format!("the remainder rate ω = {w} must be positive and finite"),
+                None => format!(
+                    "the remainder rate ω = a·(M + 1) = {} · {} overflows; lower the shape parameter a",
+                    opts.a,
+                    opts.modes + 1
+                ),
+            }));
         }
         let specs: Vec<CondSpec> = conds.iter().map(|c| CondSpec { u: c.u, order: c.order }).collect();
         let dmax = specs.iter().map(|c| c.order).max().unwrap_or(0);
@@ -192,6 +200,7 @@ impl SpectralPatch {
         let cards: Vec<Arc<CardinalSet>> = (0..=opts.modes)
             .into_par_iter()
             .map(|m| {
+                crate::cancel::checkpoint();
                 cardinal_set(opts.a * m as f64, n, &specs, kmax).map_err(|source| SpectralError::Conditions {
                     mode: m.to_string(),
                     what: what.clone(),
@@ -239,7 +248,7 @@ impl SpectralPatch {
 
     /// Diagnostics.
     pub fn report(&self) -> SpectralReport {
-        let max_mode_condition = self.cards.iter().map(|c| c.condition_number()).fold(0.0, f64::max);
+        let max_mode_condition = self.cards.iter().map(|c| c.condition_number()).max_nan();
         let mp = self.cards.iter().filter(|c| matches!(c.as_ref(), CardinalSet::Tabulated(_))).count();
         SpectralReport {
             order: 2 * self.n,
@@ -521,6 +530,7 @@ impl SpectralPatch {
             return out;
         }
         out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
+            crate::cancel::checkpoint();
             let row = self.row(u, jmax);
             for (o, col) in dst.iter_mut().zip(&cols) {
                 *o = point(&row, col);

@@ -181,6 +181,7 @@ pub fn trim_grid(map: &LaplaceMap, o: &TrimOptions) -> Result<TrimGrid, TrimErro
     let mut sweeps = 0;
     while (folds > 0 || inside > 0) && sweeps < o.max_sweeps {
         for _ in 0..10 {
+            crate::cancel::checkpoint();
             winslow_sweep(&mut p, rings, cols);
         }
         sweeps += 10;
