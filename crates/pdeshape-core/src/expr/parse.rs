@@ -36,23 +36,33 @@ impl ExprError {
     }
 }
 
+/// Characters of the source an error shows around its column (a 1 MB expression is not
+/// echoed whole).
+const EXCERPT: usize = 100;
+
 impl fmt::Display for ExprError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let col = self.column();
+        let chars: Vec<char> = self.source_text.chars().collect();
         let width = self.source_text
             [self.span.start.min(self.source_text.len())..self.span.end.min(self.source_text.len())]
             .chars()
             .count()
             .max(1);
-        write!(
-            f,
-            "{} at column {}\n    {}\n    {}{}",
-            self.message,
-            col,
-            self.source_text,
-            " ".repeat(col - 1),
-            "^".repeat(width)
-        )
+        // a window of EXCERPT characters around the column, marked where it was cut
+        let from = (col - 1).saturating_sub(EXCERPT / 2).min(chars.len().saturating_sub(EXCERPT));
+        let to = (from + EXCERPT).min(chars.len());
+        let mut excerpt: String = chars[from..to].iter().collect();
+        let mut caret = col - 1 - from;
+        if from > 0 {
+            excerpt.insert(0, '…');
+            caret += 1;
+        }
+        if to < chars.len() {
+            excerpt.push('…');
+        }
+        let width = width.min(to.saturating_sub(col - 1).max(1));
+        write!(f, "{} at column {}\n    {}\n    {}{}", self.message, col, excerpt, " ".repeat(caret), "^".repeat(width))
     }
 }
 
@@ -132,8 +142,18 @@ struct Parser<'a> {
     depth: usize,
 }
 
-/// Nesting limit: deeper input is rejected instead of overflowing the stack.
+/// Nesting limit of the parser's recursion (parentheses, unary signs, powers).
 const MAX_DEPTH: usize = 200;
+
+/// Limit on the depth of the expression *tree*. A chain `v+v+…+v` nests no parentheses but
+/// is a tree as deep as it is long, and every later pass over the tree (binding, folding,
+/// evaluation, expansion, even dropping it) recurses once per level; this keeps those
+/// passes within a small stack whatever the input (a 1 MiB text could otherwise ask for a
+/// tree 200 000 levels deep).
+pub const MAX_TREE_DEPTH: usize = 500;
+
+/// An expression with the depth of its tree.
+type Sub = (Expr, usize);
 
 impl<'a> Parser<'a> {
     fn peek(&self) -> &Tok {
@@ -169,38 +189,58 @@ impl<'a> Parser<'a> {
         Ok(())
     }
 
-    fn expr(&mut self) -> Result<Expr, ExprError> {
+    /// A node over children of depths `depths`, refused past [`MAX_TREE_DEPTH`].
+    fn node(&self, node: Node, span: Span, depth: usize) -> Result<Sub, ExprError> {
+        if depth > MAX_TREE_DEPTH {
+            return Err(ExprError::new(
+                self.src,
+                span,
+                format!(
+                    "expression too long or too deep: its tree would be more than {MAX_TREE_DEPTH} levels deep \
+                     (split long sums into parameters, or use fewer terms)"
+                ),
+            ));
+        }
+        Ok((Expr { node, span }, depth))
+    }
+
+    fn bin(&self, op: BinOp, (a, da): Sub, (b, db): Sub) -> Result<Sub, ExprError> {
+        let span = Span { start: a.span.start, end: b.span.end };
+        self.node(Node::Bin(op, Box::new(a), Box::new(b)), span, 1 + da.max(db))
+    }
+
+    fn expr(&mut self) -> Result<Sub, ExprError> {
         self.enter()?;
         let mut lhs = self.term()?;
         while let Tok::Op(c @ ('+' | '-')) = *self.peek() {
             self.next();
             let rhs = self.term()?;
             let op = if c == '+' { BinOp::Add } else { BinOp::Sub };
-            lhs = bin(op, lhs, rhs);
+            lhs = self.bin(op, lhs, rhs)?;
         }
         self.depth -= 1;
         Ok(lhs)
     }
 
-    fn term(&mut self) -> Result<Expr, ExprError> {
+    fn term(&mut self) -> Result<Sub, ExprError> {
         let mut lhs = self.unary()?;
         while let Tok::Op(c @ ('*' | '/')) = *self.peek() {
             self.next();
             let rhs = self.unary()?;
             let op = if c == '*' { BinOp::Mul } else { BinOp::Div };
-            lhs = bin(op, lhs, rhs);
+            lhs = self.bin(op, lhs, rhs)?;
         }
         Ok(lhs)
     }
 
-    fn unary(&mut self) -> Result<Expr, ExprError> {
+    fn unary(&mut self) -> Result<Sub, ExprError> {
         self.enter()?;
         let r = match *self.peek() {
             Tok::Op('-') => {
                 let (_, s) = self.next();
-                let a = self.unary()?;
+                let (a, d) = self.unary()?;
                 let span = Span { start: s.start, end: a.span.end };
-                Ok(Expr { node: Node::Neg(Box::new(a)), span })
+                self.node(Node::Neg(Box::new(a)), span, d + 1)
             }
             Tok::Op('+') => {
                 self.next();
@@ -212,20 +252,20 @@ impl<'a> Parser<'a> {
         r
     }
 
-    fn power(&mut self) -> Result<Expr, ExprError> {
+    fn power(&mut self) -> Result<Sub, ExprError> {
         let base = self.primary()?;
         if let Tok::Op('^') = self.peek() {
             self.next();
             let exp = self.unary()?;
-            return Ok(bin(BinOp::Pow, base, exp));
+            return self.bin(BinOp::Pow, base, exp);
         }
         Ok(base)
     }
 
-    fn primary(&mut self) -> Result<Expr, ExprError> {
+    fn primary(&mut self) -> Result<Sub, ExprError> {
         let (tok, span) = self.next();
         match tok {
-            Tok::Num(x) => Ok(Expr { node: Node::Num(x), span }),
+            Tok::Num(x) => Ok((Expr { node: Node::Num(x), span }, 1)),
             Tok::Ident(name) => {
                 if let Tok::Op('(') = self.peek() {
                     let func = Func::from_name(&name).ok_or_else(|| {
@@ -240,9 +280,12 @@ impl<'a> Parser<'a> {
                     })?;
                     self.next();
                     let mut args = Vec::new();
+                    let mut depth = 0;
                     if !matches!(self.peek(), Tok::Op(')')) {
                         loop {
-                            args.push(self.expr()?);
+                            let (a, d) = self.expr()?;
+                            args.push(a);
+                            depth = depth.max(d);
                             match self.peek() {
                                 Tok::Op(',') => {
                                     self.next();
@@ -271,17 +314,17 @@ impl<'a> Parser<'a> {
                             ),
                         ));
                     }
-                    Ok(Expr { node: Node::Call(func, args), span: full })
+                    self.node(Node::Call(func, args), full, depth + 1)
                 } else {
-                    Ok(Expr { node: Node::Ident(name), span })
+                    Ok((Expr { node: Node::Ident(name), span }, 1))
                 }
             }
             Tok::Op('(') => {
-                let inner = self.expr()?;
+                let (inner, d) = self.expr()?;
                 match self.peek() {
                     Tok::Op(')') => {
                         let (_, close) = self.next();
-                        Ok(Expr { node: inner.node, span: Span { start: span.start, end: close.end } })
+                        Ok((Expr { node: inner.node, span: Span { start: span.start, end: close.end } }, d))
                     }
                     t => Err(self.err(format!("expected `)`, found {}", Self::describe(t)))),
                 }
@@ -295,18 +338,13 @@ impl<'a> Parser<'a> {
     }
 }
 
-fn bin(op: BinOp, a: Expr, b: Expr) -> Expr {
-    let span = Span { start: a.span.start, end: b.span.end };
-    Expr { node: Node::Bin(op, Box::new(a), Box::new(b)), span }
-}
-
 pub(super) fn parse(src: &str) -> Result<Expr, ExprError> {
     if src.trim().is_empty() {
         return Err(ExprError::new(src, Span { start: 0, end: 0 }, "empty expression"));
     }
     let toks = lex(src)?;
     let mut p = Parser { src, toks, pos: 0, depth: 0 };
-    let e = p.expr()?;
+    let (e, _) = p.expr()?;
     if !matches!(p.peek(), Tok::End) {
         let t = p.peek().clone();
         return Err(p.err(format!("unexpected {} after a complete expression", Parser::describe(&t))));
@@ -420,5 +458,44 @@ mod tests {
         let e = Expr::parse("v + q").unwrap().bind(&["v"], &|_| None).unwrap_err();
         assert!(e.message.contains("unknown name `q`"));
         assert_eq!(e.span.start, 4);
+    }
+
+    /// Regression: `v+v+…+v` of 3 500 terms (18 KB) overflowed the editor's stack; the
+    /// parenthesis limit did not see it. Parsed on a thread with a small stack, long chains
+    /// of every operator are refused with an error naming the cap; a tree at the cap binds,
+    /// evaluates and drops within that stack.
+    #[test]
+    fn long_chains_are_refused_without_deep_recursion() {
+        std::thread::Builder::new()
+            .stack_size(1 << 20)
+            .spawn(|| {
+                for op in ["+", "-", "*", "/"] {
+                    let long = vec!["v"; 20_000].join(op);
+                    let e = Expr::parse(&long).unwrap_err();
+                    assert!(e.message.contains("too long or too deep"), "{op}: {}", e.message);
+                    assert!(e.message.contains(&MAX_TREE_DEPTH.to_string()), "{}", e.message);
+                    // the error shows an excerpt, not the 80 KB input
+                    assert!(e.to_string().len() < 600, "{op}: {} bytes", e.to_string().len());
+                }
+                // `^` is right-associative: the parser's own nesting limit refuses it first
+                let e = Expr::parse(&vec!["v"; 20_000].join("^")).unwrap_err();
+                assert!(e.message.contains("nested deeper"), "{}", e.message);
+                let signs = "-".repeat(190) + "v"; // under the nesting limit, deep unary chain
+                assert_eq!(p(&signs), 0.5);
+                // exactly at the cap: MAX_TREE_DEPTH - 1 additions of leaves
+                let at_cap = vec!["v"; MAX_TREE_DEPTH].join("+");
+                let e = Expr::parse(&at_cap).unwrap().bind(&["v"], &|_| None).unwrap();
+                assert_eq!(e.eval(&[0.5]), 0.5 * MAX_TREE_DEPTH as f64);
+                let j = e.eval_jet(&[crate::jet::Jet::variable(crate::jet::JetShape::new(&[4]), 0, 0.5)]);
+                assert_eq!(j.value(), 0.5 * MAX_TREE_DEPTH as f64);
+                let over = vec!["v"; MAX_TREE_DEPTH + 1].join("+");
+                assert!(Expr::parse(&over).is_err());
+                // nested calls count too
+                let calls = "sin(".repeat(60) + &vec!["v"; 450].join("+") + &")".repeat(60);
+                assert!(Expr::parse(&calls).unwrap_err().message.contains("too long or too deep"));
+            })
+            .unwrap()
+            .join()
+            .unwrap();
     }
 }
