@@ -89,16 +89,34 @@ impl Format {
 /// Writes meshes to `path` in `format` (atomically). Refuses meshes with non-finite
 /// values: no NaN ever reaches a file.
 pub fn write_meshes(path: &Path, format: Format, meshes: &[&Mesh]) -> io::Result<()> {
+    check_finite(meshes)?;
+    write_atomic(path, |w| encode(w, format, meshes))
+}
+
+/// The bytes of `meshes` in `format`, in memory (the editor's downloads: no file is
+/// involved). Refuses meshes with non-finite values.
+pub fn to_bytes(format: Format, meshes: &[&Mesh]) -> io::Result<Vec<u8>> {
+    check_finite(meshes)?;
+    let mut out = Vec::new();
+    encode(&mut out, format, meshes)?;
+    Ok(out)
+}
+
+fn check_finite(meshes: &[&Mesh]) -> io::Result<()> {
     for m in meshes {
         m.check_finite().map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     }
-    write_atomic(path, |w| match format {
+    Ok(())
+}
+
+fn encode(w: &mut dyn Write, format: Format, meshes: &[&Mesh]) -> io::Result<()> {
+    match format {
         Format::Obj => write_obj(w, meshes),
         Format::Ply => write_ply(w, meshes),
         Format::Stl => write_stl(w, meshes),
         Format::Glb => write_glb(w, meshes),
         Format::Vtu => write_vtu_surface(w, meshes),
-    })
+    }
 }
 
 #[cfg(test)]

@@ -11,7 +11,11 @@ let params = {};          // name -> value
 let time = null;
 let model = null;         // { header, gl buffers per patch }
 let pending = false, inflight = false, wantDiag = false;
+// after a 503 (time limit) or 429 (queue full) the next request waits: 1 s, doubling to
+// 30 s, cleared by the next answer; a slow scene then cannot be re-sent in a loop
+let backoff = 0;
 S.busy = () => inflight || pending;
+S.backoff = () => backoff;
 
 // ---------------- camera ----------------
 const cam = { az: 0.6, el: 0.45, dist: 10, target: [0, 0, 0], fov: 0.8 };
@@ -194,9 +198,11 @@ async function solve(diagnostics) {
   try {
     const r = await fetch("/api/model", { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
     if (!r.ok) {
+      if (r.status === 503 || r.status === 429) backoff = Math.min(30000, Math.max(1000, 2 * backoff));
       const e = await r.json().catch(() => ({ error: r.statusText }));
       showError(e.error);   // the edit is kept in the editor and shown as invalid, the model is not replaced
     } else {
+      backoff = 0;
       const bytes = await r.arrayBuffer();
       const n = new DataView(bytes).getUint32(0, true);
       const header = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 4, n)));
@@ -214,7 +220,11 @@ async function solve(diagnostics) {
     }
   } catch (e) { showError(String(e)); }
   inflight = false;
-  if (pending) { pending = false; const d = wantDiag; wantDiag = false; solve(d); }
+  if (pending) {
+    pending = false; const d = wantDiag; wantDiag = false;
+    if (backoff) { inflight = true; setTimeout(() => { inflight = false; solve(d); }, backoff); }
+    else solve(d);
+  }
 }
 function summary(d) {
   const lines = [];

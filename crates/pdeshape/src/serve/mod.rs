@@ -7,26 +7,38 @@
 //!   binary message: a `u32` length, a JSON header (parameters, patches, handles, trims,
 //!   diagnostics, the edited text) and little-endian `f32`/`u32` buffers it points into;
 //!   invalid scenes and edits answer 422 with the error;
-//! - `POST /api/export?format=obj|ply|stl|glb|vtu` the same request → the file.
+//! - `POST /api/export?format=obj|ply|stl|glb|vtu` the same request → the file's bytes
+//!   (built in memory; no path is ever made from a request).
 //!
-//! Limits: request bodies (1 MiB), vertices per model, solve time, concurrent solves.
-
-mod edit;
+//! Every request is treated as hostile (SPEC §14, SECURITY.md): any web page the user
+//! visits can send requests to loopback. The server answers only requests whose `Host`
+//! names the bound address or `localhost` with the bound port (DNS rebinding: 421), refuses
+//! requests whose `Origin` is another site (403) and bodies that are not JSON (415) or
+//! larger than 1 MiB (413), bounds the model's vertices and solver memory (the caps), the
+//! queue (429 past [`MAX_QUEUED`] waiting requests) and the time: the limit ([`SOLVE_LIMIT`]
+//! unless `--time-limit` says otherwise) counts
+//! from the request's arrival, queueing included, and a solve past it is cancelled (the
+//! solvers' checkpoints unwind it) and holds its slot until it has really stopped.
 
 use crate::EXAMPLES;
 use anyhow::{Context, Result};
-use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, State};
-use axum::http::{StatusCode, header};
+use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State};
+use axum::http::{HeaderMap, StatusCode, header};
+use axum::middleware::{self, Next};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
+use pdeshape_core::cancel;
+use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_io::model;
+use pdeshape_io::scene::edit;
 use pdeshape_io::scene::{LoadOptions, Scene};
 use serde::Deserialize;
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 use tokio::sync::Semaphore;
 
@@ -34,8 +46,11 @@ use tokio::sync::Semaphore;
 pub const MAX_BODY: usize = 1 << 20;
 /// Largest model (vertices over all patches) the editor solves.
 pub const MAX_VERTICES: usize = 2_000_000;
-/// Longest solve before the request is answered with an error.
+/// Default longest time from a request's arrival to its answer (queueing and solve);
+/// `serve --time-limit` changes it.
 pub const SOLVE_LIMIT: Duration = Duration::from_secs(30);
+/// Requests that may wait for a solve slot; more are refused with 429.
+pub const MAX_QUEUED: usize = 8;
 
 const PAGE: &str = include_str!("page.html");
 const APP: &str = include_str!("app.js");
@@ -48,11 +63,24 @@ pub struct ServeOptions {
     pub host: String,
     /// Port (0: any free port).
     pub port: u16,
+    /// The caps every request's scene is loaded under.
+    pub limits: Limits,
+    /// Longest time from a request's arrival to its answer.
+    pub time_limit: Duration,
 }
 
 struct AppState {
     initial: Option<(String, String)>,
-    solves: Semaphore,
+    /// One solve per core at a time; a solve holds its permit until it has stopped.
+    solves: Arc<Semaphore>,
+    /// Requests waiting for a permit.
+    queued: AtomicUsize,
+    /// `Host` values answered (lower case): the bound `host:port`, loopback names.
+    hosts: Vec<String>,
+    limits: Limits,
+    time_limit: Duration,
+    /// Worker threads of one solve.
+    threads: usize,
 }
 
 /// A request for the solved model.
@@ -81,15 +109,14 @@ pub struct ModelRequest {
 pub fn run(o: ServeOptions) -> Result<()> {
     let initial = match &o.scene {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("cannot read the scene file {}", p.display()))?;
+            let text = pdeshape_io::scene::read_scene_file(p, &o.limits)?;
             let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
             // refuse a broken scene at start, with the scene error
             Scene::parse_with(
                 &text,
                 &p.display().to_string(),
                 &name,
-                &LoadOptions { limits: crate::cli::limits(), ..Default::default() },
+                &LoadOptions { limits: o.limits, ..Default::default() },
             )?;
             Some((name, text))
         }
@@ -104,16 +131,42 @@ pub fn run(o: ServeOptions) -> Result<()> {
         println!("pdeshape editor: http://{addr}/");
         use std::io::Write as _;
         std::io::stdout().flush().ok();
-        axum::serve(listener, router(initial)).await.context("server stopped")
+        axum::serve(listener, router(initial, addr, o.limits, o.time_limit)).await.context("server stopped")
     })
 }
 
-/// The application's routes.
-pub fn router(initial: Option<(String, String)>) -> Router {
+/// The `Host` values a server bound to `addr` answers: `addr` itself and, on loopback,
+/// `localhost`, `127.0.0.1` and `[::1]`, all with the bound port.
+fn allowed_hosts(addr: std::net::SocketAddr) -> Vec<String> {
+    let port = addr.port();
+    let mut hosts = vec![addr.to_string().to_ascii_lowercase()];
+    if addr.ip().is_loopback() {
+        for h in ["localhost", "127.0.0.1", "[::1]"] {
+            hosts.push(format!("{h}:{port}"));
+        }
+    }
+    hosts
+}
+
+/// The application's routes for a server bound to `addr`.
+pub fn router(
+    initial: Option<(String, String)>,
+    addr: std::net::SocketAddr,
+    limits: Limits,
+    time_limit: Duration,
+) -> Router {
     // one solve per core at a time (each solve is parallel inside); the others queue, and
-    // the time limit counts from the start of their solve
-    let permits = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
-    let state = Arc::new(AppState { initial, solves: Semaphore::new(permits) });
+    // the time limit counts from their arrival
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
+    let state = Arc::new(AppState {
+        initial,
+        solves: Arc::new(Semaphore::new(threads)),
+        queued: AtomicUsize::new(0),
+        hosts: allowed_hosts(addr),
+        limits,
+        time_limit,
+        threads,
+    });
     Router::new()
         .route("/", get(|| async { Html(PAGE) }))
         .route("/app.js", get(|| async { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], APP) }))
@@ -123,7 +176,56 @@ pub fn router(initial: Option<(String, String)>) -> Router {
         .route("/api/model", post(model_route))
         .route("/api/export", post(export_route))
         .layer(DefaultBodyLimit::max(MAX_BODY))
+        .layer(middleware::from_fn_with_state(state.clone(), guard))
         .with_state(state)
+}
+
+/// Refuses requests for another host (DNS rebinding) and requests from another site.
+async fn guard(State(s): State<Arc<AppState>>, req: Request, next: Next) -> Response {
+    match screen(&s.hosts, req.headers()) {
+        Ok(()) => next.run(req).await,
+        Err((code, msg)) => fail(code, msg),
+    }
+}
+
+/// The header checks of [`guard`]: `Host` must be one of `hosts`; an `Origin` (sent by
+/// browsers with every cross-origin request and every POST) must be `http://` one of
+/// them; `Sec-Fetch-Site: cross-site` is refused.
+fn screen(hosts: &[String], h: &HeaderMap) -> Result<(), (StatusCode, String)> {
+    let host = h.get(header::HOST).and_then(|v| v.to_str().ok()).map(str::to_ascii_lowercase);
+    match &host {
+        Some(x) if hosts.contains(x) => {}
+        _ => {
+            return Err((
+                StatusCode::MISDIRECTED_REQUEST,
+                format!(
+                    "this editor answers only requests for {} (Host was {})",
+                    hosts.join(", "),
+                    host.as_deref().map(|x| format!("`{}`", clip(x, 80))).unwrap_or_else(|| "missing".into())
+                ),
+            ));
+        }
+    }
+    if let Some(origin) = h.get(header::ORIGIN) {
+        let o = origin.to_str().unwrap_or("").to_ascii_lowercase();
+        let same = o.strip_prefix("http://").is_some_and(|rest| hosts.iter().any(|x| x == rest));
+        if !same {
+            return Err((StatusCode::FORBIDDEN, format!("cross-site request from `{}` refused", clip(&o, 80))));
+        }
+    }
+    if h.get("sec-fetch-site").and_then(|v| v.to_str().ok()) == Some("cross-site") {
+        return Err((StatusCode::FORBIDDEN, "cross-site request refused".into()));
+    }
+    Ok(())
+}
+
+/// At most `n` characters of `s`, with an ellipsis when cut (errors never echo a whole
+/// hostile input).
+fn clip(s: &str, n: usize) -> String {
+    match s.char_indices().nth(n) {
+        Some((i, _)) => format!("{}…", &s[..i]),
+        None => s.to_string(),
+    }
 }
 
 async fn initial_scene(State(s): State<Arc<AppState>>) -> Json<Value> {
@@ -136,7 +238,7 @@ async fn initial_scene(State(s): State<Arc<AppState>>) -> Json<Value> {
 async fn example(UrlPath(name): UrlPath<String>) -> Response {
     match EXAMPLES.iter().find(|(n, _)| *n == name) {
         Some((n, t)) => Json(json!({"name": n, "text": t})).into_response(),
-        None => (StatusCode::NOT_FOUND, Json(json!({"error": format!("no example `{name}`")}))).into_response(),
+        None => fail(StatusCode::NOT_FOUND, format!("no example `{}`", clip(&name, 64))),
     }
 }
 
@@ -144,20 +246,64 @@ fn fail(code: StatusCode, msg: impl Into<String>) -> Response {
     (code, Json(json!({"error": msg.into()}))).into_response()
 }
 
-/// Runs `f` on the blocking pool under the concurrency and time limits.
+/// Counts a waiting request while alive.
+struct Queued<'a>(&'a AtomicUsize);
+impl Drop for Queued<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Runs `f` on the blocking pool under the queue, concurrency and time limits; the time
+/// counts from `arrived`. A solve past the limit is cancelled; its permit is released
+/// when it has stopped, not when the answer is sent.
 async fn limited<T: Send + 'static>(
     s: &AppState,
+    arrived: Instant,
     f: impl FnOnce() -> Result<T, String> + Send + 'static,
 ) -> Result<T, Response> {
-    let _permit = s.solves.acquire().await.map_err(|_| fail(StatusCode::SERVICE_UNAVAILABLE, "shutting down"))?;
-    match tokio::time::timeout(SOLVE_LIMIT, tokio::task::spawn_blocking(f)).await {
-        Err(_) => Err(fail(
+    let deadline = tokio::time::Instant::from_std(arrived + s.time_limit);
+    let too_slow = |what: &str| {
+        fail(
             StatusCode::SERVICE_UNAVAILABLE,
-            format!("the solve took longer than {} s (lower the resolution or order)", SOLVE_LIMIT.as_secs()),
-        )),
+            format!(
+                "{what} took longer than the editor's limit of {} s (lower the resolution, modes or order)",
+                s.time_limit.as_secs_f64()
+            ),
+        )
+    };
+    let permit = {
+        let waiting = s.queued.fetch_add(1, Ordering::SeqCst);
+        let _q = Queued(&s.queued);
+        if waiting >= MAX_QUEUED {
+            return Err(fail(
+                StatusCode::TOO_MANY_REQUESTS,
+                format!("the editor is busy: {waiting} requests are waiting for a solve; try again shortly"),
+            ));
+        }
+        match tokio::time::timeout_at(deadline, s.solves.clone().acquire_owned()).await {
+            Err(_) => return Err(too_slow("waiting for a free core")),
+            Ok(Err(_)) => return Err(fail(StatusCode::SERVICE_UNAVAILABLE, "shutting down")),
+            Ok(Ok(p)) => p,
+        }
+    };
+    let flag = Arc::new(AtomicBool::new(false));
+    let worker_flag = flag.clone();
+    let threads = s.threads;
+    let mut task = tokio::task::spawn_blocking(move || {
+        let _permit = permit; // held until the work has stopped
+        cancel::run(&worker_flag, threads, f)
+    });
+    match tokio::time::timeout_at(deadline, &mut task).await {
+        Err(_) => {
+            // raise the flag: the solve unwinds at its next checkpoint and frees its core
+            flag.store(true, Ordering::SeqCst);
+            Err(too_slow("the solve"))
+        }
         Ok(Err(e)) => Err(fail(StatusCode::INTERNAL_SERVER_ERROR, format!("the solve failed: {e}"))),
-        Ok(Ok(Err(e))) => Err(fail(StatusCode::UNPROCESSABLE_ENTITY, e)),
-        Ok(Ok(Ok(v))) => Ok(v),
+        Ok(Ok(Err(cancel::Cancelled))) => Err(too_slow("the solve")),
+        Ok(Ok(Ok(Err(e)))) => Err(fail(StatusCode::UNPROCESSABLE_ENTITY, e)),
+        Ok(Ok(Ok(Ok(v)))) => Ok(v),
     }
 }
 
@@ -168,17 +314,29 @@ struct Solved {
     solve_ms: f64,
 }
 
+/// The scene name of a request as used in answers and download names: letters, digits,
+/// `-` and `_` only (anything else becomes `_`), at most 64 characters, `scene` when empty.
+pub fn safe_name(name: Option<&str>) -> String {
+    let n: String = name
+        .unwrap_or("")
+        .chars()
+        .take(64)
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect();
+    if n.trim_matches('_').is_empty() { "scene".into() } else { n }
+}
+
 /// Applies the edits, resolves the scene and meshes every patch (at `time` for dynamic
 /// blends); errors are the scene's errors, ready to show.
-pub fn solve(req: &ModelRequest) -> Result<(Scene, String, Vec<Mesh>), String> {
+pub fn solve(req: &ModelRequest, limits: &Limits) -> Result<(Scene, String, Vec<Mesh>), String> {
     let text = edit::apply(&req.text, &req.edits)?;
-    let name = req.name.clone().unwrap_or_else(|| "scene".into());
-    let opts = LoadOptions { params: req.params.clone(), limits: crate::cli::limits(), ..Default::default() };
+    let name = safe_name(req.name.as_deref());
+    let opts = LoadOptions { params: req.params.clone(), limits: *limits, ..Default::default() };
     let scene = Scene::parse_with(&text, &format!("{name}.toml"), &name, &opts).map_err(|e| e.to_string())?;
-    let estimate: usize = scene.patches.iter().map(|p| p.resolution.0 * p.resolution.1).sum();
+    let estimate: usize = scene.patches.iter().map(|p| p.vertices()).sum();
     if estimate > MAX_VERTICES {
         return Err(format!(
-            "the model would have {estimate} vertices; the editor's limit is {MAX_VERTICES} (lower the patches' `resolution`)"
+            "the model would have {estimate} vertices; the editor's limit is {MAX_VERTICES} (lower the patches' `resolution` or `trim.resolution`)"
         ));
     }
     let meshes = scene.patches.iter().map(|p| model::editor_mesh(p, req.time)).collect::<Result<Vec<_>, _>>()?;
@@ -186,18 +344,18 @@ pub fn solve(req: &ModelRequest) -> Result<(Scene, String, Vec<Mesh>), String> {
 }
 
 async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelRequest>) -> Response {
-    let diag = req.diagnostics;
-    let r = limited(&s, move || {
+    let arrived = Instant::now();
+    let limits = s.limits;
+    // diagnostics and encoding run inside the limits too
+    let r = limited(&s, arrived, move || {
         let t0 = Instant::now();
-        let (scene, text, meshes) = solve(&req)?;
-        Ok(Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 })
+        let (scene, text, meshes) = solve(&req, &limits)?;
+        let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
+        Ok(encode(&solved, req.diagnostics))
     })
     .await;
     match r {
-        Ok(solved) => {
-            let body = encode(&solved, diag);
-            ([(header::CONTENT_TYPE, "application/octet-stream")], body).into_response()
-        }
+        Ok(body) => ([(header::CONTENT_TYPE, "application/octet-stream")], body).into_response(),
         Err(resp) => resp,
     }
 }
@@ -212,19 +370,18 @@ async fn export_route(
     Query(q): Query<ExportQuery>,
     Json(req): Json<ModelRequest>,
 ) -> Response {
+    let arrived = Instant::now();
     let Some(format) = pdeshape_io::export::Format::from_extension(&q.format) else {
         return fail(
             StatusCode::BAD_REQUEST,
-            format!("unknown format `{}` (known: obj, ply, stl, glb, vtu)", q.format),
+            format!("unknown format `{}` (known: obj, ply, stl, glb, vtu)", clip(&q.format, 16)),
         );
     };
-    let r = limited(&s, move || {
-        let (scene, _, meshes) = solve(&req)?;
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-        let path = dir.path().join(format!("{}.{}", scene.name, format.extension()));
+    let limits = s.limits;
+    let r = limited(&s, arrived, move || {
+        let (scene, _, meshes) = solve(&req, &limits)?;
         let refs: Vec<&Mesh> = meshes.iter().collect();
-        pdeshape_io::export::write_meshes(&path, format, &refs).map_err(|e| e.to_string())?;
-        let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+        let bytes = pdeshape_io::export::to_bytes(format, &refs).map_err(|e| e.to_string())?;
         Ok((scene.name, bytes))
     })
     .await;
@@ -232,6 +389,7 @@ async fn export_route(
         Ok((name, bytes)) => (
             [
                 (header::CONTENT_TYPE, "application/octet-stream".to_string()),
+                // `name` went through safe_name: no quote, slash or control character
                 (header::CONTENT_DISPOSITION, format!("attachment; filename=\"{name}.{}\"", format.extension())),
             ],
             bytes,

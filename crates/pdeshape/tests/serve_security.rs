@@ -1,0 +1,261 @@
+//! `pdeshape serve` against hostile requests (SPEC §14, SECURITY.md): raw HTTP/1.1 over
+//! loopback so that every header (Host, Origin, Content-Type) is the test's own.
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::time::{Duration, Instant};
+
+mod common;
+use common::{Kill, example};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+/// Starts `pdeshape serve --port 0` with extra arguments; returns the child and `host:port`.
+fn start(args: &[&str]) -> (Kill, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .args(["serve", "--port", "0"])
+        .args(args)
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("pdeshape serve starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+    let addr = line.trim().rsplit(' ').next().unwrap().trim_start_matches("http://").trim_end_matches('/').to_string();
+    assert!(addr.starts_with("127.0.0.1:"), "serve printed {line:?}");
+    (Kill(child), addr)
+}
+
+struct Answer {
+    status: u16,
+    headers: String,
+    body: Vec<u8>,
+}
+
+impl Answer {
+    fn text(&self) -> String {
+        String::from_utf8_lossy(&self.body).into_owned()
+    }
+}
+
+/// Sends one request (`Connection: close`) and reads the whole answer.
+fn request(addr: &str, method: &str, path: &str, headers: &[(&str, &str)], body: &[u8]) -> Answer {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
+    let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: {}\r\n", body.len());
+    for (k, v) in headers {
+        head.push_str(&format!("{k}: {v}\r\n"));
+    }
+    head.push_str("\r\n");
+    s.write_all(head.as_bytes()).unwrap();
+    s.write_all(body).unwrap();
+    let mut raw = Vec::new();
+    s.read_to_end(&mut raw).unwrap();
+    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("a complete answer");
+    let headers = String::from_utf8_lossy(&raw[..split]).into_owned();
+    let status = headers.split(' ').nth(1).unwrap().parse().unwrap();
+    let mut body = raw[split + 4..].to_vec();
+    if headers.to_ascii_lowercase().contains("transfer-encoding: chunked") {
+        body = dechunk(&body);
+    }
+    Answer { status, headers, body }
+}
+
+fn dechunk(mut b: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let eol = b.windows(2).position(|w| w == b"\r\n").unwrap();
+        let n = usize::from_str_radix(std::str::from_utf8(&b[..eol]).unwrap().trim(), 16).unwrap();
+        if n == 0 {
+            return out;
+        }
+        out.extend_from_slice(&b[eol + 2..eol + 2 + n]);
+        b = &b[eol + 2 + n + 2..];
+    }
+}
+
+fn post_json(addr: &str, path: &str, body: &serde_json::Value) -> Answer {
+    let host = addr.to_string();
+    request(
+        addr,
+        "POST",
+        path,
+        &[("Host", &host), ("Content-Type", "application/json"), ("Origin", &format!("http://{addr}"))],
+        body.to_string().as_bytes(),
+    )
+}
+
+fn scene(name: &str) -> String {
+    std::fs::read_to_string(example(name)).unwrap()
+}
+
+/// Regression (high): the export route joined the request's `name` to a directory, so
+/// `../../../../tmp/x` wrote `/tmp/x.obj`. The bytes now come from memory; the download
+/// name is sanitised; nothing is written anywhere.
+#[test]
+fn export_never_writes_a_path_from_the_request() {
+    let (_k, addr) = start(&[]);
+    let target = std::env::temp_dir().join(format!("pdeshape-escape-{}", std::process::id()));
+    let _ = std::fs::remove_file(target.with_extension("obj"));
+    for name in [format!("../../../../../..{}", target.display()), target.display().to_string()] {
+        let a = post_json(
+            &addr,
+            "/api/export?format=obj",
+            &serde_json::json!({"text": scene("hermite-ruled.toml"), "name": name}),
+        );
+        assert_eq!(a.status, 200, "{}", a.text());
+        assert!(a.text().starts_with("# pdeshape") || a.text().contains("\nv "), "an OBJ: {}", &a.text()[..80]);
+        let cd = a.headers.lines().find(|l| l.to_ascii_lowercase().starts_with("content-disposition")).unwrap();
+        let file = cd.split("filename=\"").nth(1).unwrap().trim_end_matches('"');
+        assert!(file.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)), "{cd}");
+        assert!(!file.contains(".."), "{cd}");
+        assert!(!target.with_extension("obj").exists(), "a file was written at {}", target.display());
+    }
+}
+
+/// DNS rebinding: a page on attacker.example resolving to 127.0.0.1 sends `Host:
+/// attacker.example:PORT`; such requests are refused (421) before any work.
+#[test]
+fn requests_for_other_hosts_and_from_other_sites_are_refused() {
+    let (_k, addr) = start(&[]);
+    let port = addr.rsplit(':').next().unwrap();
+    let ok = request(&addr, "GET", "/api/examples", &[("Host", &addr)], b"");
+    assert_eq!(ok.status, 200);
+    let local = format!("localhost:{port}");
+    assert_eq!(request(&addr, "GET", "/api/examples", &[("Host", &local)], b"").status, 200);
+    for host in [format!("attacker.example:{port}"), "attacker.example".into(), format!("127.0.0.1:{}1", port)] {
+        let a = request(&addr, "GET", "/", &[("Host", &host)], b"");
+        assert_eq!(a.status, 421, "Host {host}: {}", a.text());
+        assert!(a.text().contains("answers only requests for"), "{}", a.text());
+    }
+    // a POST with a foreign Origin: 403 even with the right Host
+    let body = serde_json::json!({"text": scene("hermite-ruled.toml")}).to_string();
+    let a = request(
+        &addr,
+        "POST",
+        "/api/model",
+        &[("Host", &addr), ("Content-Type", "application/json"), ("Origin", "http://attacker.example")],
+        body.as_bytes(),
+    );
+    assert_eq!(a.status, 403, "{}", a.text());
+    let a = request(
+        &addr,
+        "POST",
+        "/api/model",
+        &[("Host", &addr), ("Content-Type", "application/json"), ("Sec-Fetch-Site", "cross-site")],
+        body.as_bytes(),
+    );
+    assert_eq!(a.status, 403, "{}", a.text());
+    // a cross-site "simple" request (a form post: text/plain, no preflight) is not JSON: 415
+    let a = request(&addr, "POST", "/api/model", &[("Host", &addr), ("Content-Type", "text/plain")], body.as_bytes());
+    assert_eq!(a.status, 415, "{}", a.text());
+    // the API takes no GET
+    assert_eq!(request(&addr, "GET", "/api/model", &[("Host", &addr)], b"").status, 405);
+    // the same model request from the page's own origin works
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": scene("hermite-ruled.toml")}));
+    assert_eq!(a.status, 200, "{}", a.text());
+}
+
+/// Regression (high): 3 500 terms `v+v+…+v` (18 KB) overflowed the worker's stack and
+/// aborted the editor. Now a 422 naming the cap, and the server answers the next request.
+#[test]
+fn a_long_expression_is_an_error_not_an_abort() {
+    let (mut k, addr) = start(&[]);
+    let long = vec!["v"; 20_000].join("+");
+    let text = scene("hermite-ruled.toml").replacen("[parameters]\n", &format!("[parameters]\nq = \"{long}\"\n"), 1);
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": text}));
+    assert_eq!(a.status, 422, "{}", &a.text()[..a.text().len().min(300)]);
+    assert!(a.text().contains("too long or too deep"), "{}", &a.text()[..300.min(a.text().len())]);
+    assert!(a.text().len() < 4000, "the error echoes {} bytes", a.text().len());
+    assert!(k.0.try_wait().unwrap().is_none(), "the server died");
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": scene("hermite-ruled.toml")}));
+    assert_eq!(a.status, 200);
+}
+
+/// CPU seconds (user + system) the process has used, from /proc.
+fn cpu_seconds(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+    let fields: Vec<&str> = stat.rsplit(')').next().unwrap().split_whitespace().collect();
+    // fields after the name: state is [0]; utime [11], stime [12] (clock ticks, 100 Hz)
+    (fields[11].parse::<f64>().unwrap() + fields[12].parse::<f64>().unwrap()) / 100.0
+}
+
+/// A Klein bottle of order 64 with 65 modes: a multiple-precision solve of many seconds.
+fn slow_scene() -> String {
+    scene("klein-bottle.toml").replace("count = 40", "count = 64").replace("modes = 6", "modes = 64")
+}
+
+/// Regression (high): a solve past the limit got its 503 but kept a core busy, and its
+/// slot was released at once. Now it is cancelled: the CPU time stops growing and the next
+/// request is served at once.
+#[test]
+fn a_solve_past_its_limit_is_cancelled_and_frees_its_core() {
+    let (k, addr) = start(&["--time-limit", "2"]);
+    let pid = k.0.id();
+    let t0 = Instant::now();
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": slow_scene()}));
+    let waited = t0.elapsed();
+    assert_eq!(a.status, 503, "{}", a.text());
+    assert!(a.text().contains("longer than the editor's limit of 2 s"), "{}", a.text());
+    assert!(waited < Duration::from_secs(5), "the 503 came after {waited:?}");
+    // the cancelled solve stops within a checkpoint's time
+    std::thread::sleep(Duration::from_millis(1500));
+    let c0 = cpu_seconds(pid);
+    std::thread::sleep(Duration::from_secs(2));
+    let burnt = cpu_seconds(pid) - c0;
+    assert!(burnt < 0.3, "the server used {burnt} CPU seconds in 2 s after the cancelled solve");
+    let t1 = Instant::now();
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": scene("hermite-ruled.toml")}));
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert!(t1.elapsed() < Duration::from_secs(2), "the next request took {:?}", t1.elapsed());
+}
+
+/// Fairness: more slow requests than the queue holds get 429 at once; the queue clock
+/// includes waiting, so none waits past the limit; afterwards a fast request is served.
+#[test]
+fn the_queue_is_bounded_and_waiting_counts_toward_the_limit() {
+    let (_k, addr) = start(&["--time-limit", "3"]);
+    let n = 16; // two cores solve, eight wait: at least six are refused
+    let handles: Vec<_> = (0..n)
+        .map(|_| {
+            let addr = addr.clone();
+            std::thread::spawn(move || {
+                let t0 = Instant::now();
+                let a = post_json(&addr, "/api/model", &serde_json::json!({"text": slow_scene()}));
+                (a.status, t0.elapsed(), a.text())
+            })
+        })
+        .collect();
+    let answers: Vec<_> = handles.into_iter().map(|h| h.join().unwrap()).collect();
+    let refused = answers.iter().filter(|a| a.0 == 429).count();
+    let timed_out = answers.iter().filter(|a| a.0 == 503).count();
+    assert_eq!(refused + timed_out, n, "{:?}", answers.iter().map(|a| (a.0, &a.2)).collect::<Vec<_>>());
+    assert!(refused >= n - 8 - 2, "only {refused} refused");
+    for (status, took, text) in &answers {
+        if *status == 429 {
+            assert!(text.contains("requests are waiting"), "{text}");
+        }
+        assert!(*took < Duration::from_secs(6), "an answer took {took:?}");
+    }
+    std::thread::sleep(Duration::from_secs(2));
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": scene("hermite-ruled.toml")}));
+    assert_eq!(a.status, 200, "{}", a.text());
+}
+
+/// Caps bound the solver's memory: a static blend whose collocation system would need
+/// gigabytes is refused before allocating, naming the cap.
+#[test]
+fn solver_memory_is_checked_against_the_cap() {
+    let (_k, addr) = start(&[]);
+    let big = heavy_blend(&scene("blend-cone-cylinder.toml"));
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": big}));
+    assert_eq!(a.status, 422, "{}", a.text());
+    assert!(a.text().contains("`memory` cap"), "{}", a.text());
+}
+
+/// The first blend patch of `text` with the largest collocation grid and bubble count.
+fn heavy_blend(text: &str) -> String {
+    let at = text.find("kind = \"blend\"").expect("a blend patch");
+    let mut out = text.to_string();
+    out.insert_str(at, "solver = \"collocation\"\ncollocation = [500, 500]\nbubbles = 512\n");
+    out
+}
