@@ -21,7 +21,7 @@ pub struct Cli {
     /// Raise or lower a cap on what a scene may ask for: order (PDE order, default 64),
     /// modes (Fourier modes, sine terms, bubbles, solid terms; 512), collocation (points
     /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
-    #[arg(long = "limit", global = true, value_name = "CAP=VALUE")]
+    #[arg(long = "limit", global = true, value_name = "CAP=VALUE", value_parser = limit)]
     limit: Vec<String>,
     #[command(subcommand)]
     command: Command,
@@ -39,8 +39,8 @@ enum Command {
         #[arg(short, long)]
         out: PathBuf,
         /// Override a parameter: NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
+        set: Vec<(String, f64)>,
     },
     /// Diagnose a scene: solver, condition errors, conditioning, continuity.
     Check {
@@ -53,8 +53,8 @@ enum Command {
         #[arg(long)]
         solver: Option<String>,
         /// Override a parameter: NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
+        set: Vec<(String, f64)>,
     },
     /// Evaluate a patch at parameters read as CSV `u,v` from stdin; writes `u,v,x,y,z`.
     Sample {
@@ -64,17 +64,17 @@ enum Command {
         #[arg(long)]
         patch: Option<String>,
         /// Time, for dynamic blends.
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true, value_parser = finite)]
         time: Option<f64>,
         /// Solver for blends: auto, exact or collocation (overrides the scene).
         #[arg(long)]
         solver: Option<String>,
         /// Sine terms K of a dynamic blend's collocation solver (overrides the scene).
-        #[arg(long)]
-        terms: Option<usize>,
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        terms: Option<u64>,
         /// Override a parameter: NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
+        set: Vec<(String, f64)>,
     },
     /// Render a scene to PNG.
     Render {
@@ -83,24 +83,24 @@ enum Command {
         /// Output PNG.
         #[arg(short, long)]
         out: PathBuf,
-        /// Image width in pixels.
-        #[arg(long)]
+        /// Image width in pixels (16 to 8192).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
         width: Option<u32>,
-        /// Image height in pixels.
-        #[arg(long)]
+        /// Image height in pixels (16 to 8192).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
         height: Option<u32>,
-        /// Camera azimuth (degrees).
-        #[arg(long, allow_hyphen_values = true)]
+        /// Camera azimuth (degrees, finite).
+        #[arg(long, allow_hyphen_values = true, value_parser = finite)]
         azimuth: Option<f64>,
-        /// Camera elevation (degrees).
-        #[arg(long, allow_hyphen_values = true)]
+        /// Camera elevation (degrees, −90 to 90).
+        #[arg(long, allow_hyphen_values = true, value_parser = elevation)]
         elevation: Option<f64>,
         /// Draw mesh lines.
         #[arg(long)]
         wireframe: bool,
         /// Override a parameter: NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
+        set: Vec<(String, f64)>,
     },
     /// Build every built-in example into DIR: meshes, pictures and index.html.
     Gallery {
@@ -140,10 +140,53 @@ enum Command {
         /// Print the URL to open (it is always printed on start).
         #[arg(long)]
         open: bool,
+        /// Longest time in seconds from a request's arrival to its answer, queueing
+        /// included; a solve past it is cancelled.
+        #[arg(long, default_value_t = crate::serve::SOLVE_LIMIT.as_secs_f64(), value_parser = positive_seconds)]
+        time_limit: f64,
     },
 }
 
-/// Parses the arguments, runs, and returns the exit code.
+/// A finite number (flags that take one).
+fn finite(s: &str) -> Result<f64, String> {
+    let x: f64 = s.trim().parse().map_err(|_| format!("`{}` is not a number", clip(s, 40)))?;
+    if x.is_finite() { Ok(x) } else { Err(format!("{x} is not finite")) }
+}
+
+/// A camera elevation in degrees.
+fn elevation(s: &str) -> Result<f64, String> {
+    let x = finite(s)?;
+    if (-90.0..=90.0).contains(&x) { Ok(x) } else { Err(format!("{x} is outside [-90, 90] degrees")) }
+}
+
+/// A time limit in seconds: positive, at most a day.
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    let x = finite(s)?;
+    if x > 0.0 && x <= 86400.0 { Ok(x) } else { Err(format!("{x} is outside (0, 86400] seconds")) }
+}
+
+/// `NAME=VALUE` of `--set`, the value finite.
+fn setting(s: &str) -> Result<(String, f64), String> {
+    let (k, v) = s.split_once('=').ok_or_else(|| format!("`{}`: expected NAME=VALUE", clip(s, 40)))?;
+    let x = finite(v).map_err(|e| format!("`{}`: {e}", clip(k.trim(), 40)))?;
+    Ok((k.trim().to_string(), x))
+}
+
+/// A `--limit CAP=VALUE` setting, checked as clap parses it.
+fn limit(s: &str) -> Result<String, String> {
+    Limits::default().apply(s).map(|()| s.to_string())
+}
+
+/// At most `n` characters of `s` (errors do not echo long arguments whole).
+fn clip(s: &str, n: usize) -> String {
+    match s.char_indices().nth(n) {
+        Some((i, _)) => format!("{}…", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+/// Parses the arguments, runs, and returns the exit code: 0 ok, 1 a runtime or scene
+/// error, 2 a usage error (flags, including a `--set` name the scene does not have).
 pub fn run() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -155,57 +198,46 @@ pub fn run() -> i32 {
     };
     let mut limits = Limits::default();
     for l in &cli.limit {
-        if let Err(e) = limits.apply(l) {
-            eprintln!("error: --limit {e}");
-            return 2;
-        }
+        limits.apply(l).expect("checked by clap");
     }
-    let _ = LIMITS.set(limits);
-    match execute(cli) {
+    match execute(cli, limits) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("error: {e:#}");
-            1
+            let usage = e
+                .chain()
+                .any(|c| c.downcast_ref::<pdeshape_io::scene::SceneError>().is_some_and(|s| s.key.starts_with("--")));
+            if usage { 2 } else { 1 }
         }
     }
 }
 
-static LIMITS: std::sync::OnceLock<Limits> = std::sync::OnceLock::new();
-
-/// The caps in force for this process (`--limit`, else the defaults).
-pub fn limits() -> Limits {
-    LIMITS.get().copied().unwrap_or_default()
+/// What a command loads a scene with: the caps, `--set` values, solver and sine-term
+/// overrides.
+pub struct Load<'a> {
+    /// The caps in force (`--limit`).
+    pub limits: Limits,
+    /// `--set NAME=VALUE` overrides.
+    pub set: &'a [(String, f64)],
+    /// `--solver`.
+    pub solver: Option<&'a str>,
+    /// `--terms`.
+    pub terms: Option<usize>,
 }
 
-fn overrides(set: &[String]) -> Result<HashMap<String, f64>> {
-    let mut m = HashMap::new();
-    for s in set {
-        let (k, v) = s.split_once('=').ok_or_else(|| anyhow!("--set {s:?}: expected NAME=VALUE"))?;
-        let x: f64 = v.trim().parse().map_err(|_| anyhow!("--set {s:?}: `{v}` is not a number"))?;
-        if !x.is_finite() {
-            bail!("--set {s:?}: the value is not finite");
-        }
-        m.insert(k.trim().to_string(), x);
+impl Load<'_> {
+    /// Loads the scene file at `path`.
+    pub fn scene(&self, path: &Path) -> Result<Scene> {
+        let text = pdeshape_io::scene::read_scene_file(path, &self.limits)?;
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+        let opts = LoadOptions {
+            params: self.set.iter().cloned().collect::<HashMap<_, _>>(),
+            solver: self.solver.map(str::to_string),
+            terms: self.terms,
+            limits: self.limits,
+        };
+        Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
     }
-    Ok(m)
-}
-
-pub fn load(path: &Path, set: &[String]) -> Result<Scene> {
-    load_with(path, set, None)
-}
-
-/// Loads a scene with parameter overrides and an optional solver override.
-pub fn load_with(path: &Path, set: &[String], solver: Option<&str>) -> Result<Scene> {
-    load_opts(path, set, solver, None)
-}
-
-/// Loads a scene with parameter, solver and sine-term overrides.
-pub fn load_opts(path: &Path, set: &[String], solver: Option<&str>, terms: Option<usize>) -> Result<Scene> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {}", path.display()))?;
-    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let opts = LoadOptions { params: overrides(set)?, solver: solver.map(str::to_string), terms, limits: limits() };
-    Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
 }
 
 /// The continuity line of a blend's diagnostics: the gaps at both trimlines and the class.
@@ -239,10 +271,24 @@ fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
 
 /// Writes the scene's outputs into a directory: one file per patch and format, plus
 /// `NAME.png` for the picture. Returns the files written.
+///
+/// All or nothing: every file is first written into a staging directory inside `dir` and
+/// renamed into place only when all of them were written; a failure on the way removes the
+/// staging directory (and whatever was already renamed), so no partial set is left.
 pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create the directory {}", dir.display()))?;
     let meshes = model::patch_meshes(scene).map_err(|e| anyhow!(e))?;
-    let mut written = Vec::new();
+    let stage = tempfile::Builder::new()
+        .prefix(".pdeshape-build-")
+        .tempdir_in(dir)
+        .with_context(|| format!("cannot write into the directory {}", dir.display()))?;
+    // (file name, path in the staging directory)
+    let mut staged: Vec<String> = Vec::new();
+    let mut put = |name: String, write: &dyn Fn(&Path) -> Result<()>| -> Result<()> {
+        write(&stage.path().join(&name)).with_context(|| format!("cannot write {}", dir.join(&name).display()))?;
+        staged.push(name);
+        Ok(())
+    };
     for f in &scene.formats {
         if f == "png" {
             let img = match model::blend_strip(scene).or_else(|| model::dynamic_strip(scene)) {
@@ -253,56 +299,85 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
                     model::render_meshes(&meshes, &context, &colors, &scene.render)
                 }
             };
-            let path = dir.join(format!("{}.png", scene.name));
-            write_png(&path, &img)?;
-            written.push(path);
+            put(format!("{}.png", scene.name), &|p| Ok(write_atomic(p, |w| img.write_png(w))?))?;
             continue;
         }
         let fmt = Format::from_extension(f).ok_or_else(|| anyhow!("unknown format `{f}`"))?;
         for m in &meshes {
-            let path = dir.join(format!("{}-{}.{}", scene.name, m.name, fmt.extension()));
-            write_meshes(&path, fmt, &[m]).with_context(|| format!("cannot write {}", path.display()))?;
-            written.push(path);
+            put(format!("{}-{}.{}", scene.name, m.name, fmt.extension()), &|p| Ok(write_meshes(p, fmt, &[m])?))?;
         }
     }
     // solid blends: the hexahedral volume mesh (with residual and Jacobian cell fields)
     for p in &scene.patches {
         if let Some(h) = model::solid_volume(p) {
-            let path = dir.join(format!("{}-{}-volume.vtu", scene.name, p.name));
-            write_atomic(&path, |w| pdeshape_io::export::write_vtu_hex(w, &h))
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            written.push(path);
+            put(format!("{}-{}-volume.vtu", scene.name, p.name), &|path| {
+                Ok(write_atomic(path, |w| pdeshape_io::export::write_vtu_hex(w, &h))?)
+            })?;
         }
     }
     // dynamic blends: a numbered frame sequence beside the animated glTF
     for p in &scene.patches {
         if let Some(frames) = model::frame_meshes(p) {
             for m in frames.map_err(|e| anyhow!(e))? {
-                let path = dir.join(format!("{}-{}.obj", scene.name, m.name));
-                write_meshes(&path, Format::Obj, &[&m]).with_context(|| format!("cannot write {}", path.display()))?;
-                written.push(path);
+                put(format!("{}-{}.obj", scene.name, m.name), &|path| Ok(write_meshes(path, Format::Obj, &[&m])?))?;
             }
         }
+    }
+    // everything is written: move it into place
+    let mut written = Vec::new();
+    for name in &staged {
+        let to = dir.join(name);
+        if let Err(e) = std::fs::rename(stage.path().join(name), &to) {
+            for w in &written {
+                let _ = std::fs::remove_file(w);
+            }
+            return Err(anyhow!(e).context(format!("cannot move {} into place", to.display())));
+        }
+        written.push(to);
     }
     Ok(written)
 }
 
-fn execute(cli: Cli) -> Result<()> {
+/// Refuses a scene whose own condition check is not finite (an overflowing domain, data of
+/// 1e300): its meshes would hold finite but meaningless numbers.
+fn check_finite_report(d: &serde_json::Value) -> Result<()> {
+    for p in d["patches"].as_array().into_iter().flatten() {
+        let e = &p["condition_error"];
+        // NaN and ±∞ serialize as JSON null
+        let finite =
+            e["max_abs"].as_f64().is_some_and(f64::is_finite) && e["max_rel"].as_f64().is_some_and(f64::is_finite);
+        if !finite {
+            bail!(
+                "patch `{}`: its condition check is not finite (the values overflow or are undefined): \
+                 the result is not usable; check the domain and the data's magnitude",
+                p["name"].as_str().unwrap_or("?")
+            );
+        }
+    }
+    Ok(())
+}
+
+fn execute(cli: Cli, limits: Limits) -> Result<()> {
+    let quiet = cli.quiet;
+    let loader = |set, solver, terms: Option<u64>| Load { limits, set, solver, terms: terms.map(|t| t as usize) };
     match cli.command {
         Command::Build { scene, out, set } => {
-            let sc = load(&scene, &set)?;
+            let sc = loader(&set, None, None).scene(&scene)?;
+            // the check runs before anything is written: a scene that fails it leaves no file
+            let diagnostics = model::scene_diagnostics(&sc);
+            check_finite_report(&diagnostics)?;
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
             if ext == "png" {
                 let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
                 write_png(&out, &img)?;
-                if !cli.quiet {
+                if !quiet {
                     eprintln!("wrote {}", out.display());
                 }
             } else if let Some(fmt) = Format::from_extension(&ext) {
                 let meshes = model::patch_meshes(&sc).map_err(|e| anyhow!(e))?;
                 let refs: Vec<_> = meshes.iter().collect();
                 write_meshes(&out, fmt, &refs).with_context(|| format!("cannot write {}", out.display()))?;
-                if !cli.quiet {
+                if !quiet {
                     let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
                     eprintln!(
                         "wrote {} ({} patch{}, {nv} vertices)",
@@ -315,23 +390,22 @@ fn execute(cli: Cli) -> Result<()> {
                 bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)");
             } else {
                 let files = build_into_dir(&sc, &out)?;
-                if !cli.quiet {
+                if !quiet {
                     for f in files {
                         eprintln!("wrote {}", f.display());
                     }
                 }
             }
-            if !cli.quiet {
-                for p in &sc.patches {
-                    let d = model::patch_diagnostics(p);
+            if !quiet {
+                for d in diagnostics["patches"].as_array().into_iter().flatten() {
                     eprintln!(
                         "patch {}: {} ({}), max condition error {:.2e} (relative)",
-                        p.name,
+                        d["name"].as_str().unwrap_or(""),
                         d["kind"].as_str().unwrap_or(""),
                         d["solver"].as_str().unwrap_or(""),
                         d["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
                     );
-                    if let Some(line) = continuity_line(&d) {
+                    if let Some(line) = continuity_line(d) {
                         eprintln!("  {line}");
                     }
                 }
@@ -339,105 +413,34 @@ fn execute(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Check { scene, json, set, solver } => {
-            let sc = load_with(&scene, &set, solver.as_deref())?;
+            let sc = loader(&set, solver.as_deref(), None).scene(&scene)?;
             let d = model::scene_diagnostics(&sc);
             if json {
                 println!("{}", serde_json::to_string_pretty(&d)?);
             } else {
-                println!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
-                for p in d["patches"].as_array().into_iter().flatten() {
-                    println!(
-                        "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
-                        p["name"].as_str().unwrap_or(""),
-                        p["kind"].as_str().unwrap_or(""),
-                        p["solver"].as_str().unwrap_or(""),
-                        p["conditions"].as_array().map(|a| a.len()).unwrap_or(0),
-                        p["condition_error"]["max_abs"].as_f64().unwrap_or(f64::NAN),
-                        p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN),
-                    );
-                    let sp = &p["spectral"];
-                    if sp.is_object() {
-                        println!(
-                            "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}",
-                            sp["order"],
-                            sp["modes"],
-                            sp["omega"],
-                            sp["max_mode_condition_number"].as_f64().unwrap_or(f64::NAN),
-                            sp["modes_solved_in_f64"],
-                            sp["modes_solved_in_multiprecision"],
-                            sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
-                        );
-                    }
-                    if let Some(line) = continuity_line(p) {
-                        println!("      {line}");
-                    }
-                    if let (Some(so), Some(mp)) = (p["solid"].as_object(), p["mass_properties"].as_object()) {
-                        println!(
-                            "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",
-                            so["terms"],
-                            so["condition_number"].as_f64().unwrap_or(f64::NAN),
-                            so["rms_residual"].as_f64().unwrap_or(f64::NAN),
-                            mp["volume"].as_f64().unwrap_or(f64::NAN),
-                            mp["centroid"],
-                            mp["min_jacobian"].as_f64().unwrap_or(f64::NAN),
-                            mp["max_jacobian"].as_f64().unwrap_or(f64::NAN),
-                        );
-                    }
-                    if let Some(b) = p["blend"].as_object() {
-                        for c in b["components"].as_array().into_iter().flatten() {
-                            println!(
-                                "      {}: order {}, solver {}, {} basis functions, condition {:.2e}{}",
-                                c["component"].as_str().unwrap_or(""),
-                                c["order"],
-                                c["solver"].as_str().unwrap_or(""),
-                                c["basis"].as_array().map(|a| a.len()).unwrap_or(0),
-                                c["condition_number"].as_f64().unwrap_or(f64::NAN),
-                                c["collocation_rms_residual"]
-                                    .as_f64()
-                                    .map(|r| format!(", collocation RMS residual {r:.2e}"))
-                                    .unwrap_or_default()
-                            );
-                        }
-                        if let Some(x) = b["exact_vs_collocation_max_distance"].as_f64() {
-                            println!("      max distance between the exact and the collocation solution: {x:.3e}");
-                        }
-                    }
-                    if let Some(x) = p["section_reference_distance"].as_f64() {
-                        let lin = p["section_reference_distance_linear_s"].as_f64().unwrap_or(f64::NAN);
-                        println!(
-                            "      max distance to the section family at the fractional section index: {x:.4} \
-                             (s linear in u between sections: {lin:.4})"
-                        );
-                    }
-                    for w in p["warnings"].as_array().into_iter().flatten() {
-                        println!("      warning: {}", w.as_str().unwrap_or(""));
-                    }
-                }
+                print_check(&sc, &d);
             }
-            Ok(())
+            check_finite_report(&d)
         }
         Command::Sample { scene, patch, time, set, solver, terms } => {
-            if terms == Some(0) {
-                bail!("--terms 0: at least one sine term is needed");
-            }
-            let sc = load_opts(&scene, &set, solver.as_deref(), terms)?;
+            let sc = loader(&set, solver.as_deref(), terms).scene(&scene)?;
             let p = match &patch {
                 Some(n) => sc.patch(n).ok_or_else(|| {
                     anyhow!(
-                        "no patch named `{n}` in {} (patches: {})",
+                        "no patch named `{}` in {} (patches: {})",
+                        clip(n, 60),
                         sc.file,
                         sc.patches.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
                     )
                 })?,
                 None => sc.patches.first().ok_or_else(|| anyhow!("the scene {} has no patches", sc.file))?,
             };
-            if let Some(t) = time {
-                if !t.is_finite() {
-                    bail!("--time {t} is not finite");
-                }
-                if t != 0.0 && p.dynamic.is_none() && !cli.quiet {
-                    eprintln!("note: patch `{}` is not a dynamic blend: --time does not change it", p.name);
-                }
+            if let Some(t) = time
+                && t != 0.0
+                && p.dynamic.is_none()
+                && !quiet
+            {
+                eprintln!("note: patch `{}` is not a dynamic blend: --time does not change it", p.name);
             }
             match (&p.dynamic, time, &p.solid) {
                 (_, _, Some(sd)) => sample_solid(&sd.blend),
@@ -449,40 +452,117 @@ fn execute(cli: Cli) -> Result<()> {
             }
         }
         Command::Render { scene, out, width, height, azimuth, elevation, wireframe, set } => {
-            let mut sc = load(&scene, &set)?;
+            let mut sc = loader(&set, None, None).scene(&scene)?;
             if let Some(w) = width {
-                sc.render.size.0 = w.clamp(16, 8192);
+                sc.render.size.0 = w;
             }
             if let Some(h) = height {
-                sc.render.size.1 = h.clamp(16, 8192);
+                sc.render.size.1 = h;
             }
             if let Some(a) = azimuth {
                 sc.render.azimuth = a;
             }
             if let Some(e) = elevation {
-                sc.render.elevation = e.clamp(-90.0, 90.0);
+                sc.render.elevation = e;
             }
             sc.render.wireframe |= wireframe;
             let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
             write_png(&out, &img)?;
-            if !cli.quiet {
+            if !quiet {
                 eprintln!("wrote {}", out.display());
             }
             Ok(())
         }
-        Command::Gallery { dir } => crate::gallery::run(&dir, cli.quiet),
-        Command::Bench { scaling: Some(dir), runs, max_side, .. } => {
-            crate::bench::scaling(&dir, runs, max_side, cli.quiet)
-        }
+        Command::Gallery { dir } => crate::gallery::run(&dir, quiet),
+        Command::Bench { scaling: Some(dir), runs, max_side, .. } => crate::bench::scaling(&dir, runs, max_side, quiet),
         Command::Bench { json, runs, out, .. } => crate::bench::run(runs, json, out.as_deref()),
-        Command::Serve { scene, port, host, open: _ } => {
-            crate::serve::run(crate::serve::ServeOptions { scene, host, port })
+        Command::Serve { scene, port, host, open: _, time_limit } => crate::serve::run(crate::serve::ServeOptions {
+            scene,
+            host,
+            port,
+            limits,
+            time_limit: std::time::Duration::from_secs_f64(time_limit),
+        }),
+    }
+}
+
+/// The text report of `check`.
+fn print_check(sc: &Scene, d: &serde_json::Value) {
+    println!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
+    for p in d["patches"].as_array().into_iter().flatten() {
+        println!(
+            "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
+            p["name"].as_str().unwrap_or(""),
+            p["kind"].as_str().unwrap_or(""),
+            p["solver"].as_str().unwrap_or(""),
+            p["conditions"].as_array().map(|a| a.len()).unwrap_or(0),
+            p["condition_error"]["max_abs"].as_f64().unwrap_or(f64::NAN),
+            p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN),
+        );
+        let sp = &p["spectral"];
+        if sp.is_object() {
+            println!(
+                "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}",
+                sp["order"],
+                sp["modes"],
+                sp["omega"],
+                sp["max_mode_condition_number"].as_f64().unwrap_or(f64::NAN),
+                sp["modes_solved_in_f64"],
+                sp["modes_solved_in_multiprecision"],
+                sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
+            );
+        }
+        if let Some(line) = continuity_line(p) {
+            println!("      {line}");
+        }
+        if let (Some(so), Some(mp)) = (p["solid"].as_object(), p["mass_properties"].as_object()) {
+            println!(
+                "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",
+                so["terms"],
+                so["condition_number"].as_f64().unwrap_or(f64::NAN),
+                so["rms_residual"].as_f64().unwrap_or(f64::NAN),
+                mp["volume"].as_f64().unwrap_or(f64::NAN),
+                mp["centroid"],
+                mp["min_jacobian"].as_f64().unwrap_or(f64::NAN),
+                mp["max_jacobian"].as_f64().unwrap_or(f64::NAN),
+            );
+        }
+        if let Some(b) = p["blend"].as_object() {
+            for c in b["components"].as_array().into_iter().flatten() {
+                println!(
+                    "      {}: order {}, solver {}, {} basis functions, condition {:.2e}{}",
+                    c["component"].as_str().unwrap_or(""),
+                    c["order"],
+                    c["solver"].as_str().unwrap_or(""),
+                    c["basis"].as_array().map(|a| a.len()).unwrap_or(0),
+                    c["condition_number"].as_f64().unwrap_or(f64::NAN),
+                    c["collocation_rms_residual"]
+                        .as_f64()
+                        .map(|r| format!(", collocation RMS residual {r:.2e}"))
+                        .unwrap_or_default()
+                );
+            }
+            if let Some(x) = b["exact_vs_collocation_max_distance"].as_f64() {
+                println!("      max distance between the exact and the collocation solution: {x:.3e}");
+            }
+        }
+        if let Some(x) = p["section_reference_distance"].as_f64() {
+            let lin = p["section_reference_distance_linear_s"].as_f64().unwrap_or(f64::NAN);
+            println!(
+                "      max distance to the section family at the fractional section index: {x:.4} \
+                     (s linear in u between sections: {lin:.4})"
+            );
+        }
+        for w in p["warnings"].as_array().into_iter().flatten() {
+            println!("      warning: {}", w.as_str().unwrap_or(""));
         }
     }
 }
 
-/// Reads CSV rows of `N` finite numbers from stdin (a header line and `#` comments are
-/// skipped) and writes `header` then one line per row from `f`; errors name the line.
+/// Reads CSV rows of `N` finite numbers from stdin and writes `header` then one line per
+/// row from `f`; errors name the line. Blank lines and `#` comments are skipped, and so is
+/// a first line that is literally the column names (`u,v` or `u,v,w`, spaces allowed); a
+/// UTF-8 byte-order mark is dropped. Any other line that is not `N` numbers is an error.
 fn sample_rows<const N: usize>(
     header: &str,
     mut f: impl FnMut(usize, [f64; N], &mut dyn Write) -> Result<()>,
@@ -492,22 +572,23 @@ fn sample_rows<const N: usize>(
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     writeln!(out, "{header}")?;
+    let mut first = true;
     for (ln, line) in stdin.lock().lines().enumerate() {
-        let line = line.context("cannot read stdin")?;
-        let l = line.trim();
+        let line = line.with_context(|| format!("cannot read stdin line {}", ln + 1))?;
+        let l = if ln == 0 { line.trim_start_matches('\u{feff}') } else { &line }.trim();
         if l.is_empty() || l.starts_with('#') {
             continue;
         }
         let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
-        if ln == 0 && cols.first().is_some_and(|c| c.parse::<f64>().is_err()) {
-            continue; // header
+        if std::mem::take(&mut first) && cols.join(",") == names {
+            continue; // the header
         }
         if cols.len() != N {
-            bail!("stdin line {}: expected {N} columns `{names}`, got {}: {l:?}", ln + 1, cols.len());
+            bail!("stdin line {}: expected {N} columns `{names}`, got {}: {:?}", ln + 1, cols.len(), clip(l, 80));
         }
         let mut vals = [0.0f64; N];
         for (k, c) in cols.iter().enumerate() {
-            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{c}` is not a number", ln + 1))?;
+            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{}` is not a number", ln + 1, clip(c, 40)))?;
             if !vals[k].is_finite() {
                 bail!("stdin line {}: `{c}` is not finite", ln + 1);
             }

@@ -310,12 +310,20 @@ fn bad_arguments_and_stdin() {
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, good()).unwrap();
     let p = path.to_str().unwrap();
+    // flags are usage errors (exit 2), like --limit's: a --set name the scene lacks too
     let (code, _, err) = run(&["build", p, "-o", dir.path().join("x.obj").to_str().unwrap(), "--set", "nope=1"], "");
-    assert_eq!(code, 1);
-    assert!(err.contains("unknown parameter `nope`"), "{err}");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("unknown parameter `nope`") && err.contains("the scene has no parameters"), "{err}");
     let (code, _, err) = run(&["build", p, "-o", "x.obj", "--set", "a=zero"], "");
-    assert_eq!(code, 1);
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("is not a number"), "{err}");
+    let (code, _, err) = run(&["build", p, "-o", "x.obj", "--set", "a=nan"], "");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not finite"), "{err}");
+    let (code, _, err) = run(&["sample", p, "--time", "inf"], "");
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run(&["sample", p, "--terms", "0"], "");
+    assert_eq!(code, 2, "{err}");
     let (code, _, err) = run(&["sample", p], "0.5,abc\n");
     assert_eq!(code, 1);
     assert!(err.contains("line 1") && err.contains("`abc` is not a number"), "{err}");
@@ -420,4 +428,152 @@ fn a_raised_cap_lets_the_scene_build() {
     let mut c = Command::cargo_bin("pdeshape").unwrap();
     c.arg("build").arg(&path).arg("-o").arg(&out).args(["-q", "--limit", "modes=600"]).assert().success();
     assert!(out.exists());
+}
+
+/// The cases a hostile tester found against the CLI (issue "Trust"), each a regression
+/// test: it failed on the code before the fix.
+mod hostile {
+    use super::*;
+
+    fn scene_file(dir: &tempfile::TempDir, text: &str) -> String {
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    }
+
+    /// `check /dev/zero` read until the kernel killed it: non-regular files are refused at
+    /// once, and files over the `scene` cap (MiB) name the cap.
+    #[test]
+    fn scene_files_must_be_regular_and_small() {
+        let t0 = std::time::Instant::now();
+        let (code, _, err) = run(&["check", "/dev/zero"], "");
+        assert_eq!(code, 1, "{err}");
+        assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
+        assert!(t0.elapsed() < std::time::Duration::from_secs(5));
+        let (code, _, err) = run(&["check", "/tmp"], "");
+        assert_eq!(code, 1);
+        assert!(err.contains("a directory"), "{err}");
+        let dir = tempfile::tempdir().unwrap();
+        let p = scene_file(&dir, &format!("{}\n# {}\n", good(), "x".repeat(3 << 20)));
+        let (code, _, err) = run(&["--limit", "scene=2", "check", &p], "");
+        assert_eq!(code, 1);
+        assert!(err.contains("`scene` cap of 2 MiB") && err.contains("--limit scene=4"), "{err}");
+        let (code, _, _) = run(&["check", &p], "");
+        assert_eq!(code, 0, "under the default cap of 16 MiB");
+    }
+
+    /// `render --width 100000 --height 100000` aborted on a 40 GB allocation, `--width 0`
+    /// became 16, `--azimuth nan` wrote a blank picture: flags are checked like `[render]`.
+    #[test]
+    fn render_flags_are_validated() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = scene_file(&dir, &good());
+        let out = dir.path().join("x.png");
+        let o = out.to_str().unwrap();
+        for args in [
+            vec!["--width", "100000", "--height", "100000"],
+            vec!["--width", "0"],
+            vec!["--height", "15"],
+            vec!["--azimuth", "nan"],
+            vec!["--azimuth", "inf"],
+            vec!["--elevation", "91"],
+        ] {
+            let mut a = vec!["render", p.as_str(), "-o", o];
+            a.extend(args.iter());
+            let (code, _, err) = run(&a, "");
+            assert_eq!(code, 2, "{args:?}: {err}");
+            assert!(!out.exists(), "{args:?} wrote a picture");
+        }
+        let (code, _, err) = run(&["render", &p, "-o", o, "--width", "64", "--height", "48", "--azimuth", "-30"], "");
+        assert_eq!(code, 0, "{err}");
+        assert!(out.exists());
+    }
+
+    /// `sample` took any unparsable first line for a header (a BOM, quoted numbers, tabs:
+    /// exit 0 and no rows). Only the literal header is skipped (a BOM before it is fine).
+    #[test]
+    fn sample_accepts_only_a_literal_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = scene_file(&dir, &good());
+        for input in ["u,v\n0.5,0.25\n", "\u{feff}u,v\n0.5,0.25\n", " u , v \n0.5,0.25\n", "\u{feff}0.5,0.25\n"] {
+            let (code, out, err) = run(&["sample", &p], input);
+            assert_eq!(code, 0, "{input:?}: {err}");
+            assert_eq!(out.lines().count(), 2, "{input:?}: {out}");
+        }
+        for (input, line) in [
+            ("\"0.5\",\"0.25\"\n", 1),
+            ("0.5\t0.25\n", 1),
+            ("x,y\n0.5,0.25\n", 1),
+            ("u,v\nu,v\n", 2),
+            ("0.5,0.25\n0,1,2\n", 2),
+        ] {
+            let (code, out, err) = run(&["sample", &p], input);
+            assert_eq!(code, 1, "{input:?}: {out}");
+            assert!(err.contains(&format!("stdin line {line}")), "{input:?}: {err}");
+        }
+    }
+
+    /// `build scene -o DIR` left the files it had written when a later one failed. Here
+    /// the second format's target is taken by a directory: nothing new is left behind.
+    #[test]
+    fn a_directory_build_is_all_or_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = scene_file(&dir, &format!("{}\n[output]\nformats = [\"obj\", \"ply\"]\n", good()));
+        let out = dir.path().join("out");
+        std::fs::create_dir_all(out.join("scene-p.ply/blocker")).unwrap();
+        let (code, _, err) = run(&["build", &p, "-o", out.to_str().unwrap()], "");
+        assert_eq!(code, 1, "{err}");
+        let left: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(left, vec![std::ffi::OsString::from("scene-p.ply")], "{err}");
+        // and with the way clear, both files land
+        std::fs::remove_dir_all(out.join("scene-p.ply")).unwrap();
+        let (code, _, err) = run(&["build", &p, "-o", out.to_str().unwrap()], "");
+        assert_eq!(code, 0, "{err}");
+        let mut names: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+        names.sort();
+        assert_eq!(names, ["scene-p.obj", "scene-p.ply"]);
+    }
+
+    /// `v = [0, 1e300]` exited 0 with "max condition error NaN" and vertices of 4.6e282: a
+    /// result whose own check is not finite is an error, and nothing is written.
+    #[test]
+    fn a_result_whose_check_is_not_finite_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = "[curves.c0]\nexpr = [\"v\", \"0\", \"0\"]\n[curves.c1]\nexpr = [\"v\", \"0\", \"1\"]\n[patches.p]\n\
+                    kind = \"pde\"\nv = [0, 1e300]\nconditions = [{ u = 0, curve = \"c0\" }, { u = 1, curve = \"c1\" }]\n";
+        let p = scene_file(&dir, text);
+        let out = dir.path().join("x.obj");
+        let (code, _, err) = run(&["build", &p, "-o", out.to_str().unwrap()], "");
+        assert_eq!(code, 1, "{err}");
+        assert!(err.contains("not finite"), "{err}");
+        assert!(!out.exists());
+        let (code, _, err) = run(&["check", &p], "");
+        assert_eq!(code, 1, "{err}");
+    }
+
+    /// Small ones: an overflowing cap value, a 200 KB line echoed twice on stderr, an
+    /// overflowing ω, Debug text in errors.
+    #[test]
+    fn errors_are_short_and_say_what_is_wrong() {
+        let (code, _, err) = run(&["--limit", "vertices=18446744073709551616", "check", "x.toml"], "");
+        assert_eq!(code, 2);
+        assert!(err.contains("larger than the largest cap"), "{err}");
+        let dir = tempfile::tempdir().unwrap();
+        let long = format!("{}\n[parameters]\nq = \"{}\"\n", good(), "v+".repeat(100_000));
+        let p = scene_file(&dir, &long);
+        let (code, _, err) = run(&["check", &p], "");
+        assert_eq!(code, 1);
+        assert!(err.len() < 4000, "{} bytes of stderr", err.len());
+        let text = format!(
+            "{GOOD_CURVES}\n[parameters]\na = 1e308\n[patches.p]\nkind = \"pde\"\na = \"a\"\nconditions = [{{ u = 0, curve = \"c0\" }}, {{ u = 1, curve = \"c1\" }}]\n"
+        );
+        let p = scene_file(&dir, &text);
+        let (code, _, err) = run(&["check", &p], "");
+        assert_eq!(code, 1);
+        assert!(err.contains("overflows") && !err.contains("ω = inf must be positive"), "{err}");
+        let p = scene_file(&dir, &good().replace("\"0\"]", "\"1/(v - v)\"]"));
+        let (code, _, err) = run(&["check", &p], "");
+        assert_eq!(code, 1);
+        assert!(!err.contains("Vec3 {"), "{err}");
+    }
 }

@@ -239,7 +239,12 @@ fn check_name(
 fn build_params(ctx: &mut Ctx, raw: &IndexMap<String, Spanned<RawParam>>, overrides: &HashMap<String, f64>) -> R<()> {
     for name in overrides.keys() {
         if !raw.contains_key(name) {
-            return Err(ctx.err(None, "parameters", format!("unknown parameter `{name}`")));
+            let known = if raw.is_empty() {
+                "the scene has no parameters".to_string()
+            } else {
+                format!("parameters: {}", raw.keys().map(String::as_str).collect::<Vec<_>>().join(", "))
+            };
+            return Err(ctx.err(None, "--set", format!("unknown parameter `{name}` ({known})")));
         }
     }
     #[derive(Clone, Copy, PartialEq)]
@@ -1116,7 +1121,7 @@ fn build_dynamic(
         None => 11,
         Some(f) => ctx.int(f, 2, 1000, &format!("{key}.frames"))? as usize,
     };
-    let mut opts = DynamicOptions { times, ..Default::default() };
+    let mut opts = DynamicOptions { times, limits: ctx.limits, ..Default::default() };
     if let Some(sv) = ctx.solver_choice(&rp.solver, key)? {
         opts.solver = sv;
     }
@@ -1205,7 +1210,7 @@ fn build_blend(
         ops.push(op);
     }
     let ops: [Operator; 3] = ops.try_into().expect("three operators");
-    let mut options = BlendOptions::default();
+    let mut options = BlendOptions { limits: ctx.limits, ..Default::default() };
     if let Some(sv) = ctx.solver_choice(&rp.solver, key)? {
         options.solver = sv;
     }
@@ -1360,7 +1365,14 @@ fn check_data(ctx: &Ctx, data: &FieldRef, domain: VDomain, sp: Option<Range<usiz
         let v = domain.at(k as f64 / 64.0);
         let g = data.eval(&[v, 0.0]);
         if !g.is_finite() {
-            return Err(ctx.err(sp, key, format!("the data are not finite at v = {v:.6} (value {g:?})")));
+            return Err(ctx.err(
+                sp,
+                key,
+                format!(
+                    "the data are not finite at v = {} (value {g})",
+                    if v.abs() < 1e6 { format!("{v:.6}") } else { format!("{v:.6e}") }
+                ),
+            ));
         }
     }
     if domain.periodic {

@@ -9,6 +9,7 @@
 #![allow(clippy::result_large_err)]
 
 mod build;
+pub mod edit;
 mod error;
 mod raw;
 mod trim;
@@ -127,8 +128,20 @@ pub struct ScenePatch {
     pub trim: Option<TrimSetup>,
 }
 
-/// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid. The map
 impl ScenePatch {
+    /// Vertices of the patch's mesh: the trim grid's when trimmed, else the resolution's
+    /// (a solid's boundary mesh counts its six faces).
+    pub fn vertices(&self) -> usize {
+        if let Some(sd) = &self.solid {
+            let (a, b, c) = sd.cells;
+            return 2 * (a * b + b * c + a * c);
+        }
+        match &self.trim {
+            Some(t) => t.grid.rings * (t.grid.columns + 1),
+            None => self.resolution.0 * self.resolution.1,
+        }
+    }
+
     /// Estimated bytes of this patch's meshes (what [`crate::model::patch_mesh`] and the
     /// exporters hold): the surface grid or trimmed grid with its per-vertex fields, every
     /// frame of a dynamic blend, the hexahedral cells of a solid.
@@ -141,16 +154,14 @@ impl ScenePatch {
             let cells = a as u128 * b as u128 * c as u128;
             return cells * (24 + 8 * 4 + 32) + Mesh::grid_bytes(2 * (a * b + b * c + a * c), 0, 0);
         }
-        let vertices = match &self.trim {
-            Some(t) => t.grid.rings * (t.grid.columns + 1),
-            None => self.resolution.0 * self.resolution.1,
-        };
+        let vertices = self.vertices();
         let fields = if self.blend.is_some() { 5 } else { 0 };
         let frames = self.dynamic.as_ref().map_or(0, |d| d.frames);
         Mesh::grid_bytes(vertices, fields, frames)
     }
 }
 
+/// A patch's trim: the Laplace map of its region and the repaired `(ρ, φ)` grid. The map
 /// is solved in the metric-scaled plane `(u, k v)` (see `scale`).
 #[derive(Clone, Debug)]
 pub struct TrimSetup {
@@ -384,18 +395,47 @@ pub struct Scene {
     pub studies: Vec<Study>,
 }
 
+/// Reads a scene file: a regular file (not a device, FIFO or directory: `/dev/zero` would
+/// never end) of at most `limits.scene` MiB, in UTF-8. Errors name the file and the cause.
+pub fn read_scene_file(path: &Path, limits: &pdeshape_core::limits::Limits) -> Result<String, SceneError> {
+    use std::io::Read;
+    let file = path.display().to_string();
+    let fail = |message: String| SceneError {
+        file: file.clone(),
+        line: None,
+        column: None,
+        key: String::new(),
+        message,
+        snippet: None,
+        caret: 0,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() { "a directory" } else { "not a regular file (a device, FIFO or socket)" };
+        return Err(fail(format!("cannot read the scene file: it is {what}")));
+    }
+    let cap = limits.scene as u64 * (1 << 20);
+    let too_big = |len: u64| {
+        limits
+            .check(pdeshape_core::limits::Cap::Scene, len.div_ceil(1 << 20), "the scene file's size")
+            .map_err(|e| fail(e.to_string()))
+    };
+    too_big(meta.len())?;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
+        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    too_big(bytes.len() as u64)?; // it grew while being read
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!("the scene file is not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()))
+    })
+}
+
 impl Scene {
     /// Loads a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-            file: file.clone(),
-            line: None,
-            column: None,
-            key: String::new(),
-            message: format!("cannot read the scene file: {e}"),
-            snippet: None,
-        })?;
+        let text = read_scene_file(path, &pdeshape_core::limits::Limits::default())?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
         Scene::parse(&text, &file, &name, &HashMap::new())
     }
