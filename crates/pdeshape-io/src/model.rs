@@ -5,6 +5,7 @@ use crate::scene::{RenderSettings, Scene, ScenePatch};
 use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, continuity, gaps_at};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
+use pdeshape_core::num::MaxNan;
 use pdeshape_core::patch::{Condition, Surface};
 use pdeshape_core::patch::{PrimarySurface, check_conditions};
 use serde_json::{Value, json};
@@ -196,21 +197,75 @@ pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
     scene.patches.iter().map(patch_mesh).collect()
 }
 
-/// FNV-1a (64-bit) over the `f32` bits of every position, in order: the fingerprint of a
-/// model the editor shows to its page and tests compare with the library's meshes.
+/// FNV-1a (64-bit) over every buffer of every mesh, in order: names, the `f64` bits of
+/// positions, normals, UVs, fields, curves and animation frames, the face indices and the
+/// grid shape, each buffer preceded by its length (so moving a value from one buffer to the
+/// next changes the hash). The fingerprint of a model the editor shows to its page and the
+/// tests compare with the library's meshes (thread independence, the load test): equal
+/// hashes mean bit-identical meshes, not equal `f32` renderings.
 pub fn mesh_hash(meshes: &[Mesh]) -> String {
-    let mut h: u64 = 0xcbf29ce484222325;
+    struct Fnv(u64);
+    impl Fnv {
+        fn bytes(&mut self, b: &[u8]) {
+            for &x in b {
+                self.0 ^= x as u64;
+                self.0 = self.0.wrapping_mul(0x100000001b3);
+            }
+        }
+        fn len(&mut self, n: usize) {
+            self.bytes(&(n as u64).to_le_bytes());
+        }
+        fn f64s(&mut self, xs: impl ExactSizeIterator<Item = f64>) {
+            self.len(xs.len());
+            for x in xs {
+                self.bytes(&x.to_bits().to_le_bytes());
+            }
+        }
+        fn vec3s(&mut self, v: &[pdeshape_core::Vec3]) {
+            self.f64s(v.iter().flat_map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>().into_iter());
+        }
+        fn u32s(&mut self, xs: &[u32]) {
+            self.len(xs.len());
+            for x in xs {
+                self.bytes(&x.to_le_bytes());
+            }
+        }
+    }
+    let mut h = Fnv(0xcbf29ce484222325);
+    h.len(meshes.len());
     for m in meshes {
-        for p in &m.positions {
-            for x in [p.x as f32, p.y as f32, p.z as f32] {
-                for b in x.to_le_bytes() {
-                    h ^= b as u64;
-                    h = h.wrapping_mul(0x100000001b3);
+        h.len(m.name.len());
+        h.bytes(m.name.as_bytes());
+        h.vec3s(&m.positions);
+        h.vec3s(&m.normals);
+        h.f64s(m.uvs.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        h.u32s(m.quads.as_flattened());
+        h.u32s(m.triangles.as_flattened());
+        h.len(m.fields.len());
+        for f in &m.fields {
+            h.bytes(f.name.as_bytes());
+            h.f64s(f.values.iter().copied());
+        }
+        match m.grid {
+            Some((a, b)) => h.u32s(&[1, a as u32, b as u32]),
+            None => h.u32s(&[0]),
+        }
+        h.len(m.curves.len());
+        for c in &m.curves {
+            h.vec3s(c);
+        }
+        match &m.animation {
+            None => h.len(0),
+            Some(a) => {
+                h.len(1);
+                h.f64s(a.times.iter().copied());
+                for f in a.positions.iter().chain(&a.normals) {
+                    h.vec3s(f);
                 }
             }
         }
     }
-    format!("{h:016x}")
+    format!("{:016x}", h.0)
 }
 
 /// Meshes of the primary surfaces drawn in context (those with an `s_range`).
@@ -396,8 +451,8 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
             for (w, k, f) in [(0.0, 0, 0), (0.0, 1, 1), (1.0, 0, 2), (1.0, 1, 3)] {
                 let d = s.derivatives(u, v, w, 0, 0, 1)[k];
                 let g = sd.faces[f].eval(&[u, v]);
-                worst = worst.max((d - g).norm());
-                size = size.max(g.norm());
+                worst = pdeshape_core::num::max_nan(worst, (d - g).norm());
+                size = pdeshape_core::num::max_nan(size, g.norm());
             }
         }
     }
@@ -423,7 +478,7 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
         "kind": "solid",
         "solver": rep.method,
         "conditions": [{"w": 0, "order": 0}, {"w": 0, "order": 1}, {"w": 1, "order": 0}, {"w": 1, "order": 1}],
-        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": worst / size.max(f64::MIN_POSITIVE), "patch_size": size},
+        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": worst / pdeshape_core::num::max_nan(size, f64::MIN_POSITIVE), "patch_size": size},
         "solid": {
             "terms": [rep.terms.0, rep.terms.1, rep.terms.2],
             "condition_number": rep.condition_number,
@@ -450,9 +505,8 @@ fn trim_diagnostics(t: &crate::scene::TrimSetup) -> Value {
     let r = &g.report;
     let region = t.map.region();
     let k = t.scale;
-    let boundary = (0..g.columns)
-        .map(|j| region.loop_distance([g.points[j][0] * k[0], g.points[j][1] * k[1]]))
-        .fold(0.0, f64::max);
+    let boundary =
+        (0..g.columns).map(|j| region.loop_distance([g.points[j][0] * k[0], g.points[j][1] * k[1]])).max_nan();
     json!({
         "curves": region.curves.iter().map(|c| c.0.clone()).collect::<Vec<_>>(),
         "bridges": region.bridges.len(),
@@ -668,11 +722,12 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             "modes_solved_in_f64": r.methods.0,
             "modes_solved_in_multiprecision": r.methods.1,
             "lebesgue_mode0": r.lebesgue.0,
-            "lebesgue_mode1": r.lebesgue.1,
-            "rms_residual_truncated": if have_t && residuals { json!((t2 / n).sqrt()) } else { Value::Null },
-            "rms_residual_remainder": if residuals { json!((r2 / n).sqrt()) } else { Value::Null },
-            "rms_residual_whole": if have_t && residuals { json!((w2 / n).sqrt()) } else { Value::Null },
         });
+        let s = &mut d["spectral"];
+        put(s, "lebesgue_mode1", r.lebesgue.1);
+        put(s, "rms_residual_truncated", (have_t && residuals).then(|| (t2 / n).sqrt()));
+        put(s, "rms_residual_remainder", residuals.then(|| (r2 / n).sqrt()));
+        put(s, "rms_residual_whole", (have_t && residuals).then(|| (w2 / n).sqrt()));
         let leb = r.lebesgue.0.max(r.lebesgue.1.unwrap_or(0.0));
         if leb > LEBESGUE_WARNING {
             let msg = format!(
@@ -709,11 +764,11 @@ pub fn blend_condition_report(b: &StaticBlend, conds: &[Condition]) -> pdeshape_
             for i in 0..CHECK_SAMPLES {
                 let v = dom.at((i as f64 + 0.37) / CHECK_SAMPLES as f64);
                 let e = (b.u_derivative(c.u, v, c.order)[t] - c.data.eval(&[v, 0.0])[t]).abs();
-                rep.max_abs = rep.max_abs.max(e);
+                rep.max_abs = pdeshape_core::num::max_nan(rep.max_abs, e);
             }
         }
     }
-    rep.max_rel = rep.max_abs / rep.size.max(f64::MIN_POSITIVE);
+    rep.max_rel = rep.max_abs / pdeshape_core::num::max_nan(rep.size, f64::MIN_POSITIVE);
     rep
 }
 
@@ -743,8 +798,21 @@ pub fn continuity_class(ends: &[Gaps], size: f64) -> &'static str {
     if c1 { "C1" } else { "G1" }
 }
 
+/// Inserts `key: v` when `v` was computed. A value that was not computed is left out
+/// rather than written as `null`: `null` in a report means a NaN or an infinity (serde_json
+/// writes them so), which the tests refuse.
+fn put(obj: &mut Value, key: &str, v: Option<impl Into<Value>>) {
+    if let (Some(v), Some(o)) = (v, obj.as_object_mut()) {
+        o.insert(key.to_string(), v.into());
+    }
+}
+
 fn gaps_json(g: &Gaps) -> Value {
-    json!({ "c0": g.c0, "c1": g.c1, "g1_radians": g.g1, "c2": g.c2, "g2": g.g2 })
+    let mut o = json!({});
+    for (k, v) in [("c0", g.c0), ("c1", g.c1), ("g1_radians", g.g1), ("c2", g.c2), ("g2", g.g2)] {
+        put(&mut o, k, v);
+    }
+    o
 }
 
 fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut Value, size: f64) {
@@ -755,7 +823,7 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
         .zip(["x", "y", "z"])
         .zip(b.operators())
         .map(|((r, axis), op)| {
-            json!({
+            let mut c = json!({
                 "component": axis,
                 "order": r.order,
                 "coefficients": op.coefficients(),
@@ -764,9 +832,14 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
                 "exact_available": r.exact_available,
                 "basis": r.basis,
                 "condition_number": r.condition_number,
-                "collocation_rms_residual": r.collocation_rms,
-                "collocation": r.collocation.map(|(l, q, nb)| json!({"u_points": l, "v_points": q, "bubbles": nb})),
-            })
+            });
+            put(&mut c, "collocation_rms_residual", r.collocation_rms);
+            put(
+                &mut c,
+                "collocation",
+                r.collocation.map(|(l, q, nb)| json!({"u_points": l, "v_points": q, "bubbles": nb})),
+            );
+            c
         })
         .collect();
     // When both solvers apply, how far apart their surfaces are.
@@ -784,7 +857,7 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
             for i in 0..=50 {
                 for j in 0..50 {
                     let (u, v) = (i as f64 / 50.0, dom.at((j as f64 + 0.5) / 50.0));
-                    worst = worst.max((b.point(u, v) - q.point(u, v)).norm());
+                    worst = pdeshape_core::num::max_nan(worst, (b.point(u, v) - q.point(u, v)).norm());
                 }
             }
             Some(worst)
@@ -797,10 +870,8 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
             continuity(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], 400)
         })
         .collect();
-    d["blend"] = json!({
-        "components": comps,
-        "exact_vs_collocation_max_distance": distance,
-    });
+    d["blend"] = json!({ "components": comps });
+    put(&mut d["blend"], "exact_vs_collocation_max_distance", distance);
     d["continuity"] = json!({
         "start": gaps_json(&ends[0]),
         "end": gaps_json(&ends[1]),
@@ -841,9 +912,9 @@ pub fn convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
         for i in 1..16 {
             for j in 0..32 {
                 let (u, v) = (i as f64 / 16.0, dom.at((j as f64 + 0.5) / 32.0));
-                rem = rem.max(q.remainder(u, v).norm());
+                rem = pdeshape_core::num::max_nan(rem, q.remainder(u, v).norm());
                 if let Some(r) = q.residual(u, v).whole {
-                    mx = mx.max(r);
+                    mx = pdeshape_core::num::max_nan(mx, r);
                     s2 += r * r;
                     n += 1.0;
                 }
@@ -897,7 +968,7 @@ pub fn blend_convergence_plot(scene: &Scene) -> Option<Result<Image, String>> {
             for i in 0..=40 {
                 for j in 0..48 {
                     let (u, v) = (i as f64 / 40.0, dom.at((j as f64 + 0.5) / 48.0));
-                    worst = worst.max((q.point(u, v) - exact.point(u, v)).norm());
+                    worst = pdeshape_core::num::max_nan(worst, (q.point(u, v) - exact.point(u, v)).norm());
                 }
             }
             // exact agreement shows as the round-off floor
@@ -945,7 +1016,7 @@ pub fn solid_convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
         let r2: f64 = pts.iter().map(|&(u, v, w)| s.residual(u, v, w).norm().powi(2)).sum::<f64>() / pts.len() as f64;
         rms.push((n as f64, r2.sqrt().max(1e-16)));
         if let Some(pv) = &prev {
-            let d = pv.iter().zip(&xs).map(|(a, b)| (*a - *b).norm()).fold(0.0, f64::max);
+            let d = pv.iter().zip(&xs).map(|(a, b)| (*a - *b).norm()).max_nan();
             change.push((n as f64, d.max(1e-16)));
         }
         prev = Some(xs);
@@ -987,4 +1058,59 @@ pub fn scene_diagnostics(scene: &Scene) -> Value {
         "parameters": scene.params.iter().map(|(k, p)| (k.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
         "patches": scene.patches.iter().map(patch_diagnostics).collect::<Vec<_>>(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdeshape_core::Vec3;
+
+    fn mesh() -> Mesh {
+        Mesh {
+            name: "m".into(),
+            positions: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            normals: vec![Vec3::new(0.0, 0.0, 1.0); 3],
+            uvs: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            triangles: vec![[0, 1, 2]],
+            ..Default::default()
+        }
+    }
+
+    /// Regression: the hash read only the f32-rounded positions, so meshes that differ in
+    /// their normals, UVs, faces or below f32 precision compared equal.
+    #[test]
+    fn the_hash_sees_every_buffer_and_every_bit() {
+        let h = mesh_hash(&[mesh()]);
+        assert_eq!(h, mesh_hash(&[mesh()]));
+        let mut changes: Vec<Mesh> = Vec::new();
+        let mut m = mesh();
+        m.positions[1].x = f64::from_bits(1f64.to_bits() + 1); // below f32 resolution
+        changes.push(m);
+        let mut m = mesh();
+        m.normals[2].z = f64::from_bits(1f64.to_bits() - 1);
+        changes.push(m);
+        let mut m = mesh();
+        m.uvs[0][1] = 1e-300;
+        changes.push(m);
+        let mut m = mesh();
+        m.triangles[0] = [0, 2, 1];
+        changes.push(m);
+        let mut m = mesh();
+        m.fields.push(pdeshape_core::mesh::ScalarField { name: "f".into(), values: vec![0.0; 3] });
+        changes.push(m);
+        let mut m = mesh();
+        m.name = "n".into();
+        changes.push(m);
+        for (k, m) in changes.iter().enumerate() {
+            assert_ne!(mesh_hash(std::slice::from_ref(m)), h, "change {k} not seen");
+        }
+        // a value moved from one buffer to the next changes the hash
+        let mut a = mesh();
+        a.uvs.pop();
+        let mut b = mesh();
+        b.uvs.pop();
+        b.normals.push(Vec3::ZERO);
+        a.normals.pop();
+        assert_ne!(mesh_hash(&[a]), mesh_hash(&[b]));
+    }
 }

@@ -13,9 +13,11 @@ fn example(name: &str) -> String {
     std::fs::read_to_string(common::example(name)).unwrap()
 }
 
-/// The page's fingerprint of the library's meshes for the scene.
+/// The fingerprint of the library's editor meshes for the scene (every buffer, every bit:
+/// what the server sends must be exactly what the library computes).
 fn hash(scene: &Scene) -> String {
-    model::mesh_hash(&model::patch_meshes(scene).unwrap())
+    let meshes: Vec<_> = scene.patches.iter().map(|p| model::editor_mesh(p, None).unwrap()).collect();
+    model::mesh_hash(&meshes)
 }
 
 fn header(body: &[u8]) -> Value {
