@@ -52,23 +52,62 @@ fn sample(args: &[&str], input: &str) -> Vec<[f64; 5]> {
         .collect()
 }
 
-/// `sample --time` evaluates any instant; the closed form at u = 0 reproduces eq. 19's data
-/// and the paper's approximation (K = 5, 11 × 11) stays within a few hundredths of it.
+mod common;
+use common::hermite_ode::{self, Basis};
+
+/// The closed form of paper 002's eq. 19 blend, derived by hand (not through the project's
+/// ODE core). Every boundary function is `e^{κt}` times `sin v` or `cos v` (`μ = −1`), or a
+/// constant (`μ = κ = 0`), so `S = Σ_j G_j(u) F_j(v, t)` with
+/// `β G⁗ + γμ G″ + (λμ² + ρκ² + ηκ) G = 0`; with `β = λ = ρ = η = 1`, `γ = 12.1`:
+/// `s⁴ − 12.1 s² + c₀ = 0`, `c₀ = 3` for `κ = 1` and `c₀ = 1` for `κ = −1`, four real roots
+/// `±p, ±q` with `p², q² = (12.1 ± √(12.1² − 4c₀))/2`. The z component is the Hermite cubic.
+fn eq19(u: f64, v: f64, t: f64) -> [f64; 3] {
+    let (a, b, c, d, h0, h1) = (1.6, 1.0, 0.8, 0.6, 2.0, -3.0);
+    let kernel = |c0: f64| -> Vec<Basis> {
+        let disc = (12.1f64 * 12.1 - 4.0 * c0).sqrt();
+        let (p, q) = (((12.1 + disc) / 2.0).sqrt(), ((12.1 - disc) / 2.0).sqrt());
+        vec![hermite_ode::exp(p), hermite_ode::exp(-p), hermite_ode::exp(q), hermite_ode::exp(-q)]
+    };
+    // G with G(0) = g0, G′(0) = 0, G(1) = g1, G′(1) = 0 (the tangents of both cylinders are
+    // vertical: no sin/cos part)
+    let g = |c0: f64, g0: f64, g1: f64| {
+        let k = kernel(c0);
+        let coef = hermite_ode::fit(&k, &[g0, 0.0], &[g1, 0.0]);
+        hermite_ode::eval(&k, &coef, u, 0)
+    };
+    let x = (g(3.0, a, 0.0) * t.exp() + g(1.0, 0.0, c) * (-t).exp()) * v.sin();
+    let y = (g(1.0, b, 0.0) * (-t).exp() + g(3.0, 0.0, d) * t.exp()) * v.cos();
+    let (u2, u3) = (u * u, u * u * u);
+    let z = h0 * (1.0 - 3.0 * u2 + 2.0 * u3) + h1 * (u - 2.0 * u2 + u3) + h1 * (u3 - u2);
+    [x, y, z]
+}
+
+/// `sample --time` at any instant: the exact solver equals the hand-derived closed form of
+/// eq. 19 at 400 points per instant; the paper's approximation (K = 5 sine terms, 11 × 11
+/// collocation) stays within its measured distance of it.
 #[test]
-fn sample_any_time_with_either_solver() {
-    let input: String = (0..40).map(|i| format!("{},{}\n", i as f64 / 39.0, 0.3 + i as f64 * 0.15)).collect();
+fn sample_any_time_equals_the_closed_form() {
+    let input: String = (0..400)
+        .map(|i| format!("{},{}\n", (i as f64 * 0.618_033_988_749_895).fract(), (i as f64 * 0.0157) % 6.2))
+        .collect();
     for t in [0.0f64, 0.17, 0.3] {
         let ts = t.to_string();
         let exact = sample(&["--time", &ts, "--solver", "exact"], &input);
         let approx = sample(&["--time", &ts, "--solver", "collocation", "--terms", "5"], &input);
-        let mut worst: f64 = 0.0;
+        assert_eq!(exact.len(), 400);
+        let (mut err_exact, mut err_approx): (f64, f64) = (0.0, 0.0);
         for (e, a) in exact.iter().zip(&approx) {
-            worst = worst.max((0..3).map(|k| (e[2 + k] - a[2 + k]).abs()).fold(0.0, f64::max));
+            let want = eq19(e[0], e[1], t);
+            for k in 0..3 {
+                err_exact = pdeshape_core::num::max_nan(err_exact, (e[2 + k] - want[k]).abs());
+                err_approx = pdeshape_core::num::max_nan(err_approx, (a[2 + k] - want[k]).abs());
+            }
         }
-        assert!(worst > 1e-6 && worst < 0.05, "t = {t}: approximation differs by {worst}");
-        let top = exact[0];
-        assert!((top[2] - 1.6 * t.exp() * top[1].sin()).abs() < 1e-13);
-        assert!((top[3] - (-t).exp() * top[1].cos()).abs() < 1e-13);
+        // O(1) values from a well-conditioned 4 × 4 fit: round-off
+        assert!(err_exact < 1e-12, "t = {t}: exact solver vs closed form {err_exact:e}");
+        // SPEC §5: the K = 5 approximation is off by a few 1e-3 (G_1 alone: 4.4e-3 at the
+        // collocation points); measured here: see the message
+        assert!(err_approx > 1e-4 && err_approx < 1e-2, "t = {t}: K = 5 vs closed form {err_approx:e}");
     }
 }
 

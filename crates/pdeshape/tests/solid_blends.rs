@@ -67,6 +67,34 @@ fn cube_volume_matches_the_analytic_integral() {
     let vol = d["mass_properties"]["volume"].as_f64().unwrap();
     assert!((vol - 8.0 * int).abs() < 1e-10 * vol, "{vol} vs {}", 8.0 * int);
     assert!(d["solid"]["max_coefficient"].as_f64().unwrap() < 1e-13);
+
+    // The boundary mesh, exactly: at height z = 4 − 2w the solid's section is the
+    // rectangle |x| ≤ f(w), |y| ≤ g(w); the mesh's side faces are planar trapezoids
+    // between its w nodes, so its sections interpolate f and g linearly there and it
+    // encloses 8 Σ_i ∫ f_lin g_lin dw = 8 Σ_i h_i (2f_i g_i + f_i g_{i+1} + f_{i+1} g_i +
+    // 2 f_{i+1} g_{i+1}) / 6 over the mesh's nodes (read from its z values).
+    let m = model::patch_mesh(&scene.patches[0]).unwrap();
+    let poly = |c: &[f64; 4], w: f64| c.iter().rev().fold(0.0, |acc, a| acc * w + a);
+    let mut ws: Vec<f64> = m.positions.iter().map(|p| (4.0 - p.z) / 2.0).collect();
+    ws.sort_by(f64::total_cmp);
+    ws.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    assert_eq!(ws.len(), 17, "the mesh's vertex rows in w");
+    let mut want = 0.0;
+    for k in 0..ws.len() - 1 {
+        let (w0, w1) = (ws[k], ws[k + 1]);
+        let (f0, f1, g0, g1) = (poly(&f, w0), poly(&f, w1), poly(&g, w0), poly(&g, w1));
+        want += 8.0 * (w1 - w0) * (2.0 * f0 * g0 + f0 * g1 + f1 * g0 + 2.0 * f1 * g1) / 6.0;
+    }
+    let enclosed: f64 = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum();
+    // a sum of a few thousand O(1) tetrahedra: round-off
+    assert!((enclosed - want).abs() < 1e-12 * want, "mesh encloses {enclosed}, the polyhedron {want}");
 }
 
 #[test]

@@ -132,3 +132,63 @@ fn bad_trims_are_refused_with_the_place_and_the_cause() {
         &["patches.q.conditions[0].trim", "patch `p` has no trim"],
     );
 }
+
+/// The delivered mesh of the circle example, independently of the mesher's own counters:
+/// every face has positive signed area in (u, v) (no fold, one orientation), and the faces
+/// cover the domain minus the hole exactly. Ring 0 lies on the circle, so the hole the mesh
+/// leaves is the inscribed polygon through ring 0: its area falls short of πr² by
+/// `Σ r²(θ_i − sin θ_i)/2` over the polygon's central angles θ_i, which is the only
+/// difference from `1 − πr²` allowed (plus round-off).
+#[test]
+fn trimmed_mesh_covers_the_domain_minus_the_hole_without_folds() {
+    let scene = Scene::load(&example("trim-circle.toml")).unwrap();
+    let p = &scene.patches[0];
+    let m = model::patch_mesh(p).unwrap();
+    let dom = p.surface.v_domain();
+    let uv = |i: u32| {
+        let t = m.uvs[i as usize];
+        [t[0], dom.start + t[1] * (dom.end - dom.start)]
+    };
+    let area = |c: &[u32]| {
+        // shoelace formula of the face's corners in (u, v)
+        let n = c.len();
+        (0..n)
+            .map(|k| {
+                let (a, b) = (uv(c[k]), uv(c[(k + 1) % n]));
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum::<f64>()
+            / 2.0
+    };
+    let mut total = 0.0;
+    let mut smallest = f64::INFINITY;
+    for f in m.quads.iter().map(|q| q.to_vec()).chain(m.triangles.iter().map(|t| t.to_vec())) {
+        let a = area(&f);
+        assert!(a > 0.0, "face {f:?} has signed (u, v) area {a:e}");
+        smallest = smallest.min(a);
+        total += a;
+    }
+    // the circle: centre (0.5, 0.5), radius 0.22 (the scene's values), domain [0, 1]²
+    let (c, r) = ([0.5, 0.5], 0.22);
+    let ring0: Vec<[f64; 2]> = (0..p.trim.as_ref().unwrap().grid.columns).map(|j| uv(j as u32)).collect();
+    for q in &ring0 {
+        let d = ((q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2)).sqrt();
+        assert!((d - r).abs() < 1e-12, "ring 0 off the circle by {:e}", d - r);
+    }
+    let mut angles: Vec<f64> = ring0.iter().map(|q| (q[1] - c[1]).atan2(q[0] - c[0])).collect();
+    angles.sort_by(f64::total_cmp);
+    let deficit: f64 = (0..angles.len())
+        .map(|k| {
+            let next = if k + 1 < angles.len() { angles[k + 1] } else { angles[0] + std::f64::consts::TAU };
+            let th = next - angles[k];
+            r * r * (th - th.sin()) / 2.0
+        })
+        .sum();
+    let want = 1.0 - std::f64::consts::PI * r * r + deficit;
+    assert!(
+        (total - want).abs() < 1e-12,
+        "faces cover {total}, the domain minus the hole {want} (deficit {deficit:e})"
+    );
+    assert!(deficit > 0.0 && deficit < 1e-3, "deficit {deficit:e}");
+    assert!(smallest > 0.0);
+}

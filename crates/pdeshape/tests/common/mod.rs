@@ -1,6 +1,8 @@
 //! Helpers shared by the editor tests: a `pdeshape serve` child that dies with the test.
 #![allow(dead_code)]
 
+pub mod hermite_ode;
+
 use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
