@@ -2,6 +2,12 @@
 //! points with normals; the Klein bottle (order 40) at 200 × 200; the dynamic blend of
 //! paper 002 eq. 19 (closed form and K = 5) at 100 × 100; the solid blend of paper 000
 //! example 2 (solve at L = M = N = 6, evaluation at 64³).
+//!
+//! One thread (the global rayon pool is built with one worker: the SPEC targets are for one
+//! core), and nothing memoised between iterations of a solve: each iteration changes a
+//! parameter by a hair, so the cardinal functions (memoised across solves by their rates)
+//! are computed anew every time.
+//!
 //! Run: cargo bench -p pdeshape-io --bench surfaces
 use criterion::{Criterion, criterion_group, criterion_main};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
@@ -19,7 +25,17 @@ fn load(name: &str) -> Scene {
     Scene::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).expect("example loads")
 }
 
+/// A new value every call: `base · (1 + 1e-9 k)` for the k-th call.
+fn fresh(base: f64) -> impl FnMut() -> f64 {
+    let mut k = 0u64;
+    move || {
+        k += 1;
+        base * (1.0 + 1e-9 * k as f64)
+    }
+}
+
 fn surfaces(c: &mut Criterion) {
+    rayon::ThreadPoolBuilder::new().num_threads(1).build_global().expect("one worker thread");
     let bw = load("bloor-wilson-blend.toml");
     let four = load("four-curve-patch.toml");
     let klein = load("klein-bottle.toml");
@@ -47,7 +63,13 @@ fn surfaces(c: &mut Criterion) {
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/bloor-wilson-blend.toml"),
     )
     .unwrap();
-    g.bench_function("bloor-wilson solve", |b| b.iter(|| Scene::parse(&text, "b", "b", &Default::default()).unwrap()));
+    let mut a = fresh(1.0);
+    g.bench_function("bloor-wilson solve (new a each time)", |b| {
+        b.iter(|| {
+            let params = std::collections::HashMap::from([("a".to_string(), a())]);
+            Scene::parse(&text, "b", "b", &params).unwrap()
+        })
+    });
     g.finish();
 
     // SPEC §10: paper 002 eq. 19 at one t, 100 × 100 points with normals: the closed form
@@ -58,9 +80,13 @@ fn surfaces(c: &mut Criterion) {
     let mut g = c.benchmark_group("dynamic blend eq. 19, solve + 100x100 with normals");
     for (label, solver) in [("closed form", Solver::Exact), ("K = 5, 11 x 11", Solver::Collocation)] {
         let o = DynamicOptions { solver, terms: 5, collocation: (11, 11), times: d.times, ..Default::default() };
+        let mut gamma = fresh(d.blend.operator().gamma);
         g.bench_function(label, |b| {
             b.iter(|| {
-                let blend = DynamicBlend::new(d.blend.operator(), &p.conditions, p.surface.v_domain(), &o).unwrap();
+                let op0 = d.blend.operator();
+                let op = pdeshape_core::blend::DynamicOperator::new(op0.beta, gamma(), op0.lambda, op0.rho, op0.eta)
+                    .unwrap();
+                let blend = DynamicBlend::new(op, &p.conditions, p.surface.v_domain(), &o).unwrap();
                 grid_mesh(&blend.frame(0.1).unwrap(), &GridOptions::new(100, 100)).expect("finite")
             })
         });
