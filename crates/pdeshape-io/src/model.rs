@@ -442,7 +442,8 @@ pub const LEBESGUE_WARNING: f64 = 1e3;
 
 /// Diagnostics of a solid patch: the four boundary conditions on a 50 × 50 grid of
 /// `(u, v)`, the solve, mass properties, the RMS PDE residual at interior points.
-fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
+/// A solid's four face conditions on a 50 × 50 grid of each face.
+fn solid_condition_report(sd: &crate::scene::SolidSetup) -> pdeshape_core::patch::ConditionReport {
     let s = sd.blend.as_ref();
     let (mut worst, mut size) = (0.0f64, 0.0f64);
     for i in 0..50 {
@@ -456,6 +457,42 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
             }
         }
     }
+    let rel = worst / pdeshape_core::num::max_nan(size, f64::MIN_POSITIVE);
+    pdeshape_core::patch::ConditionReport { max_abs: worst, max_rel: rel, size }
+}
+
+/// The patch's condition check alone (what `check` reports as `condition_error`, without
+/// the rest of the diagnostics): every condition at [`CHECK_SAMPLES`] points, every frame
+/// of a dynamic blend, a solid's four faces. NaN when anything evaluated is NaN.
+pub fn condition_report(p: &ScenePatch) -> pdeshape_core::patch::ConditionReport {
+    if let Some(sd) = &p.solid {
+        return solid_condition_report(sd);
+    }
+    if let Some(b) = &p.blend {
+        return blend_condition_report(b.blend.as_ref(), &p.conditions);
+    }
+    if let Some(dy) = &p.dynamic {
+        let mut worst = pdeshape_core::patch::ConditionReport { max_abs: 0.0, max_rel: 0.0, size: 0.0 };
+        for t in dy.frame_times() {
+            let r = match dy.blend.frame(t) {
+                Ok(f) => check_conditions(&f, &p.conditions, t, CHECK_SAMPLES),
+                Err(_) => {
+                    pdeshape_core::patch::ConditionReport { max_abs: f64::NAN, max_rel: f64::NAN, size: f64::NAN }
+                }
+            };
+            if !(r.max_rel < worst.max_rel) {
+                worst = r;
+            }
+        }
+        return worst;
+    }
+    check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES)
+}
+
+fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
+    let s = sd.blend.as_ref();
+    let check = solid_condition_report(sd);
+    let (worst, size) = (check.max_abs, check.size);
     let mp = s.mass_properties(16);
     // interior points (boundary surfaces may have singular derivatives on the edges)
     let mut r2 = 0.0;
@@ -478,7 +515,7 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
         "kind": "solid",
         "solver": rep.method,
         "conditions": [{"w": 0, "order": 0}, {"w": 0, "order": 1}, {"w": 1, "order": 0}, {"w": 1, "order": 1}],
-        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": worst / pdeshape_core::num::max_nan(size, f64::MIN_POSITIVE), "patch_size": size},
+        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": check.max_rel, "patch_size": size},
         "solid": {
             "terms": [rep.terms.0, rep.terms.1, rep.terms.2],
             "condition_number": rep.condition_number,
@@ -721,6 +758,7 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             "max_mode_condition_number": r.max_mode_condition,
             "modes_solved_in_f64": r.methods.0,
             "modes_solved_in_multiprecision": r.methods.1,
+            "mode_paths": r.mode_paths,
             "lebesgue_mode0": r.lebesgue.0,
         });
         let s = &mut d["spectral"];

@@ -347,14 +347,17 @@ fn check_finite_report(d: &serde_json::Value) -> Result<()> {
         let finite =
             e["max_abs"].as_f64().is_some_and(f64::is_finite) && e["max_rel"].as_f64().is_some_and(f64::is_finite);
         if !finite {
-            bail!(
-                "patch `{}`: its condition check is not finite (the values overflow or are undefined): \
-                 the result is not usable; check the domain and the data's magnitude",
-                p["name"].as_str().unwrap_or("?")
-            );
+            bail!(not_finite(p["name"].as_str().unwrap_or("?")));
         }
     }
     Ok(())
+}
+
+fn not_finite(patch: &str) -> String {
+    format!(
+        "patch `{patch}`: its condition check is not finite (the values overflow or are undefined): \
+         the result is not usable; check the domain and the data's magnitude"
+    )
 }
 
 fn execute(cli: Cli, limits: Limits) -> Result<()> {
@@ -363,9 +366,21 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
     match cli.command {
         Command::Build { scene, out, set } => {
             let sc = loader(&set, None, None).scene(&scene)?;
-            // the check runs before anything is written: a scene that fails it leaves no file
-            let diagnostics = model::scene_diagnostics(&sc);
-            check_finite_report(&diagnostics)?;
+            // the condition check runs before anything is written: a scene that fails it
+            // leaves no file (quiet: the check alone; otherwise the whole report, printed below)
+            let diagnostics = if quiet {
+                for p in &sc.patches {
+                    let r = model::condition_report(p);
+                    if !(r.max_abs.is_finite() && r.max_rel.is_finite()) {
+                        bail!(not_finite(&p.name));
+                    }
+                }
+                serde_json::Value::Null
+            } else {
+                let d = model::scene_diagnostics(&sc);
+                check_finite_report(&d)?;
+                d
+            };
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
             if ext == "png" {
                 let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;

@@ -77,3 +77,22 @@ fn red_blood_cell_follows_the_biconcave_profile() {
     }
     assert!(worst < 0.03, "distance from the biconcave profile {worst}");
 }
+
+/// Order 40 in plain f64 at both ends of the Klein bottle's slider (`a` = 0.3 and 3.0):
+/// every mode and the remainder take an f64 path (the exponential basis or the
+/// ultraspherical Chebyshev system, none multiple precision), and the 40 sections hold to
+/// 1e-10 relative at the check's 1000 samples.
+#[test]
+fn klein_bottle_is_exact_in_f64_across_the_slider() {
+    let text = example_text("klein-bottle.toml");
+    for a in [0.3, 3.0] {
+        let scene = Scene::parse(&text, "k.toml", "k", &HashMap::from([("a".to_string(), a)])).unwrap();
+        let r = model::condition_report(&scene.patches[0]);
+        assert!(r.max_rel <= 1e-10, "a = {a}: sections met to {:e}", r.max_rel);
+        let rep = scene.patches[0].spectral.as_ref().unwrap().report();
+        assert_eq!(rep.methods.1, 0, "a = {a}: {:?}", rep.mode_paths);
+        assert_eq!(rep.mode_paths.len(), 8, "modes 0…6 and the remainder");
+        assert!(rep.mode_paths.iter().all(|p| p.starts_with("f64")), "a = {a}: {:?}", rep.mode_paths);
+        assert!(rep.mode_paths.contains(&"f64-ultraspherical"), "a = {a}: {:?}", rep.mode_paths);
+    }
+}

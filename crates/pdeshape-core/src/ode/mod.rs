@@ -21,15 +21,21 @@
 //!   pivoting, with the condition number of the condition matrix and the Lebesgue
 //!   constant `max_u Σ_i |ℓ_i(u)|` (how much the conditions' data can be amplified between
 //!   them).
+//! - [`UltraCardinal`] computes the same functions as Chebyshev series from a
+//!   well-conditioned ultraspherical system, in f64, where the exponential basis is
+//!   ill-conditioned; [`ChebCardinal`] does it in multiple precision, the last resort;
+//!   [`CardinalSet`] picks the first that is accurate.
 
 mod cardinal;
 mod poly;
 mod precise;
 mod set;
 mod space;
+mod ultraspherical;
 
 pub use cardinal::{Cardinal, CondSpec, OdeError};
 pub use poly::{CLUSTER_TOL, PolyRoots, polynomial_from_roots, polynomial_roots};
 pub use precise::ChebCardinal;
 pub use set::{CardinalSet, F64_COND_LIMIT};
 pub use space::{CLUSTER_GAP, ExpSpace, Root};
+pub use ultraspherical::{ULTRA_COND_LIMIT, UltraCardinal};

@@ -147,25 +147,43 @@ pub struct ConditionReport {
 /// grid is favoured) at time `t`.
 pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: usize) -> ConditionReport {
     let dom = s.v_domain();
+    let vs: Vec<f64> = (0..samples)
+        .map(|k| {
+            // a low-discrepancy jitter (golden ratio) keeps the samples off any solver grid
+            let f = ((k as f64 + 0.5) / samples as f64 + 0.618_033_988_749_895 * 1e-3 * k as f64) % 1.0;
+            dom.at(f)
+        })
+        .collect();
+    // conditions of order 0 and 1 and the size samples at u = 0, ½, 1 on the grid path
+    // (`Surface::grid`: the solvers share per-row and per-column work there); higher orders
+    // pointwise
+    let mut us: Vec<f64> = vec![0.0, 0.5, 1.0];
+    for c in conds.iter().filter(|c| c.order <= 1) {
+        if !us.contains(&c.u) {
+            us.push(c.u);
+        }
+    }
+    let g = s.grid(&us, &vs);
+    let at = |u: f64, j: usize| &g[us.iter().position(|x| *x == u).expect("a grid row") * vs.len() + j];
     let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut hi = -lo;
     let mut max_abs: f64 = 0.0;
-    for k in 0..samples {
-        // a low-discrepancy jitter (golden ratio) keeps the samples off any solver grid
-        let f = ((k as f64 + 0.5) / samples as f64 + 0.618_033_988_749_895 * 1e-3 * k as f64) % 1.0;
-        let v = dom.at(f);
+    for (j, &v) in vs.iter().enumerate() {
         for c in conds {
-            let x = s.u_derivative(c.u, v, c.order);
-            let g = c.data.eval(&[v, t]);
-            let e = (x - g).norm();
+            let x = match c.order {
+                0 => at(c.u, j)[0],
+                1 => at(c.u, j)[1],
+                k => s.u_derivative(c.u, v, k),
+            };
+            let e = (x - c.data.eval(&[v, t])).norm();
             max_abs = crate::num::max_nan(max_abs, e);
             if c.order == 0 {
                 lo = lo.min(x);
                 hi = hi.max(x);
             }
         }
-        for &u in &[0.0, 0.5, 1.0] {
-            let p = s.point(u, v);
+        for u in [0.0, 0.5, 1.0] {
+            let p = at(u, j)[0];
             lo = lo.min(p);
             hi = hi.max(p);
         }

@@ -120,8 +120,12 @@ pub struct SpectralReport {
     /// Largest condition number over the mode systems (f64 solve) or inverse size
     /// (multiple precision).
     pub max_mode_condition: f64,
-    /// How the cardinal functions were computed: counts of `f64` and `multiprecision` modes.
+    /// How the cardinal functions were computed: counts of `f64` (exponential basis or
+    /// ultraspherical) and `multiprecision` modes.
     pub methods: (usize, usize),
+    /// The path of every mode `0 … M` and then of the remainder (`"f64"`,
+    /// `"f64-ultraspherical"`, `"multiprecision"`).
+    pub mode_paths: Vec<&'static str>,
     /// Lebesgue constants of the condition set for mode 0 and mode 1 (amplification of
     /// the data between the conditions).
     pub lebesgue: (f64, Option<f64>),
@@ -256,6 +260,7 @@ impl SpectralPatch {
             omega: self.omega,
             max_mode_condition,
             methods: (self.cards.len() - mp, mp),
+            mode_paths: self.cards.iter().chain(std::iter::once(&self.rem)).map(|c| c.method()).collect(),
             lebesgue: (self.cards[0].lebesgue(400), self.cards.get(1).map(|c| c.lebesgue(400))),
         }
     }

@@ -1,0 +1,343 @@
+//! Cardinal functions in plain f64 by the ultraspherical spectral method (Olver & Townsend,
+//! "A fast and well-conditioned spectral method", SIAM Review 55, 2013).
+//!
+//! The exponential basis `uᵏ e^{r u}` of `K = ker P(D)` is ill-conditioned when the roots
+//! are small and repeated (order 40 at `c = a·m ≈ 1`: condition numbers of 1e20 and more),
+//! but the problem is not: the cardinal functions are smooth and bounded. Here they are
+//! computed as Chebyshev series `ℓ(u) = Σ_{m<K} a_m T_m(x)`, `x = 2u − 1`, from a square
+//! system that stays well conditioned:
+//!
+//! - `P(D_u) = Σ_k p_k D_u^k = Σ_k p_k 2^k D_x^k`, and `D_x^k` maps Chebyshev-T
+//!   coefficients to coefficients in the ultraspherical basis `C^{(k)}`:
+//!   `D_x^k T_m = 2^{k−1}(k−1)! m C^{(k)}_{m−k}` (`m ≥ k ≥ 1`);
+//! - conversions `S_λ: C^{(λ)} → C^{(λ+1)}` bring every term to `C^{(n)}` (`n = deg P`):
+//!   `T_0 = C^{(1)}_0`, `T_m = ½(C^{(1)}_m − C^{(1)}_{m−2})`, and for `λ ≥ 1`
+//!   `C^{(λ)}_m = λ/(m+λ) (C^{(λ+1)}_m − C^{(λ+1)}_{m−2})`; in Horner form
+//!   `R ← S_λ R + p_{λ+1} 2^{λ+1} 𝒟_{λ+1}`, each step banded;
+//! - the system: the `n` condition rows `ℓ^{(d_i)}(u_i) = Σ_m a_m 2^{d_i} T_m^{(d_i)}(x_i)`
+//!   and the first `K − n` rows of `P(D)` in `C^{(n)}` (equal to zero), each row scaled to
+//!   unit maximum; one LU solve gives all `n` cardinal functions (right-hand sides `e_i`).
+//!
+//! The result is accepted only when it is resolved (the last coefficients are below
+//! `1e-14` of the largest), meets its conditions to `1e-12`, and the system's condition
+//! number (`‖A‖₁‖A⁻¹‖₁`, reported) is below [`ULTRA_COND_LIMIT`]; otherwise the caller
+//! falls back to multiple precision. Tested against an independent mpmath table
+//! (`tests/cardinal_reference.rs`).
+
+use super::{CondSpec, ExpSpace, OdeError};
+use faer::Mat;
+use faer::linalg::solvers::Solve;
+
+/// Largest condition number of the row-scaled ultraspherical system that is accepted: the
+/// same bound as the exponential basis's (errors up to about `cond × ε` ≈ 1e-12). Value
+/// conditions stay far below it (order 40: 20 … 160); derivative conditions of order 2 and
+/// 3 at both ends reach 1e6 (errors of 1e-10, measured against multiple precision), and go
+/// to multiple precision.
+pub const ULTRA_COND_LIMIT: f64 = 1e4;
+
+/// Cardinal functions as Chebyshev series on `[0, 1]` (see the module docs).
+#[derive(Clone, Debug)]
+pub struct UltraCardinal {
+    /// `coef[k][i]`: Chebyshev coefficients (in `x = 2u − 1`) of `ℓ_i^{(k)}` (derivatives
+    /// in `u`).
+    coef: Vec<Vec<Vec<f64>>>,
+    kmax: usize,
+    dim: usize,
+    cond: f64,
+    size: usize,
+    /// Values at the condition points from the system's own rows, `Σ_m a_m 2^k T_m^{(k)}(x_i)`:
+    /// the solve makes them cardinal to round-off, while the differentiated series lose
+    /// accuracy in high derivatives at the ends (`T_m^{(k)}(±1)` grows like `m^{2k}`).
+    at_conditions: Vec<(f64, Vec<Vec<f64>>)>,
+}
+
+/// `T_m^{(d)}(x)` for `m < count`, `d ≤ dmax`: `t[d][m]`, by
+/// `T_{m+1}^{(d)} = 2x T_m^{(d)} + 2d T_m^{(d−1)} − T_{m−1}^{(d)}`.
+fn chebyshev_derivatives(x: f64, count: usize, dmax: usize) -> Vec<Vec<f64>> {
+    let mut t = vec![vec![0.0; count]; dmax + 1];
+    for d in 0..=dmax {
+        for m in 0..count {
+            t[d][m] = match m {
+                0 => f64::from(d == 0),
+                1 => match d {
+                    0 => x,
+                    1 => 1.0,
+                    _ => 0.0,
+                },
+                _ => {
+                    let lower = if d > 0 { 2.0 * d as f64 * t[d - 1][m - 1] } else { 0.0 };
+                    2.0 * x * t[d][m - 1] + lower - t[d][m - 2]
+                }
+            };
+        }
+    }
+    t
+}
+
+/// Coefficients of `f′` (in `x`) from those of `f` (Chebyshev-T).
+fn differentiate(a: &[f64]) -> Vec<f64> {
+    let k = a.len();
+    let mut b = vec![0.0; k + 1];
+    for m in (1..k).rev() {
+        b[m - 1] = b[m + 1] + 2.0 * m as f64 * a[m];
+    }
+    b[0] *= 0.5;
+    b.truncate(k.max(1));
+    b
+}
+
+/// Clenshaw's sum `Σ c_m T_m(t)`.
+fn clenshaw(c: &[f64], t: f64) -> f64 {
+    let (mut b1, mut b2) = (0.0, 0.0);
+    for &cj in c.iter().skip(1).rev() {
+        let b0 = 2.0 * t * b1 - b2 + cj;
+        b2 = b1;
+        b1 = b0;
+    }
+    t * b1 - b2 + c.first().copied().unwrap_or(0.0)
+}
+
+/// `log₂(2^{k−1} (k−1)!)`, the size of `D_x^k`'s entries per unit `m`.
+fn log2_dk(k: usize) -> f64 {
+    if k == 0 {
+        return 0.0;
+    }
+    (k - 1) as f64 + (1..k).map(|j| (j as f64).log2()).sum::<f64>()
+}
+
+impl UltraCardinal {
+    /// The cardinal functions of `conds` in `space`, with derivatives up to `kmax`, or an
+    /// error when the series is not resolved or the system is too ill-conditioned (the
+    /// caller then uses multiple precision).
+    pub fn new(space: &ExpSpace, conds: &[CondSpec], kmax: usize) -> Result<Self, OdeError> {
+        let n = space.dim();
+        if conds.len() != n {
+            return Err(OdeError::Count { got: conds.len(), dim: n });
+        }
+        let c = space.roots().iter().map(|r| r.re.abs() + r.im.abs()).fold(0.0, crate::num::max_nan);
+        if !c.is_finite() {
+            return Err(OdeError::Polynomial("roots are not finite".into()));
+        }
+        let mut size = n + 40 + (1.2 * c).ceil() as usize;
+        for _ in 0..2 {
+            match Self::solve(space, conds, kmax, size) {
+                Err(Unresolved) => size = size * 3 / 2,
+                Ok(u) => return u,
+            }
+        }
+        Err(OdeError::Singular {
+            cond: f64::NAN,
+            detail: format!(": the Chebyshev series is not resolved with {size} terms"),
+        })
+    }
+
+    fn solve(
+        space: &ExpSpace,
+        conds: &[CondSpec],
+        kmax: usize,
+        size: usize,
+    ) -> Result<Result<Self, OdeError>, Unresolved> {
+        let n = space.dim();
+        let p = super::polynomial_from_roots(space.roots()); // ascending, monic, degree n
+        debug_assert_eq!(p.len(), n + 1);
+        // scales: term k has entries p_k 2^k 2^{k−1}(k−1)! · m; normalise by the largest
+        let logs: Vec<f64> = p
+            .iter()
+            .enumerate()
+            .map(|(k, pk)| if *pk == 0.0 { f64::NEG_INFINITY } else { pk.abs().log2() + k as f64 + log2_dk(k) })
+            .collect();
+        let top = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let factor = |k: usize| if logs[k].is_finite() { p[k].signum() * (logs[k] - top).exp2() } else { 0.0 };
+        // Horner in the C^{(λ)} bases, (K + 2n) rows so that no conversion is truncated
+        let rows = size + 2 * n;
+        let mut r = vec![vec![0.0; size]; rows];
+        for (j, row) in r.iter_mut().enumerate().take(size) {
+            row[j] = factor(0);
+        }
+        for lam in 0..n {
+            // S_λ on every column: row j ← s1(j) row j + s2(j) row j+2
+            for j in 0..rows {
+                let (s1, s2) = if lam == 0 {
+                    (if j == 0 { 1.0 } else { 0.5 }, -0.5)
+                } else {
+                    let l = lam as f64;
+                    (l / (j as f64 + l), -l / (j as f64 + 2.0 + l))
+                };
+                let below = if j + 2 < rows { Some(r[j + 2].clone()) } else { None };
+                for (m, x) in r[j].iter_mut().enumerate() {
+                    *x = s1 * *x + below.as_ref().map_or(0.0, |b| s2 * b[m]);
+                }
+            }
+            // + p_{λ+1} 2^{λ+1} D_{λ+1}: entry (j, j + k) = 2^{k−1}(k−1)! (j + k), scaled
+            let k = lam + 1;
+            let f = factor(k);
+            if f != 0.0 {
+                for (j, row) in r.iter_mut().enumerate() {
+                    if j + k < size {
+                        row[j + k] += f * (j + k) as f64;
+                    }
+                }
+            }
+        }
+        // the system: condition rows, then K − n operator rows, each scaled to unit maximum
+        let mut a = Mat::<f64>::zeros(size, size);
+        let mut b = Mat::<f64>::zeros(size, n);
+        for (i, cd) in conds.iter().enumerate() {
+            let t = chebyshev_derivatives(2.0 * cd.u - 1.0, size, cd.order);
+            let scale = 2f64.powi(cd.order as i32);
+            let row: Vec<f64> = t[cd.order].iter().map(|x| x * scale).collect();
+            let mx = row.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+            if !(mx.is_finite() && mx > 0.0) {
+                return Ok(Err(OdeError::Singular {
+                    cond: f64::INFINITY,
+                    detail: format!(": condition row {i} is not finite"),
+                }));
+            }
+            for (m, x) in row.iter().enumerate() {
+                a[(i, m)] = x / mx;
+            }
+            b[(i, i)] = 1.0 / mx;
+        }
+        for j in 0..size - n {
+            let mx = r[j].iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+            if !mx.is_finite() {
+                return Ok(Err(OdeError::Singular { cond: f64::INFINITY, detail: ": operator rows overflow".into() }));
+            }
+            let mx = if mx > 0.0 { mx } else { 1.0 };
+            for m in 0..size {
+                a[(n + j, m)] = r[j][m] / mx;
+            }
+        }
+        let lu = a.partial_piv_lu();
+        let x = lu.solve(&b);
+        // condition number ‖A‖₁ ‖A⁻¹‖₁
+        let inv = lu.solve(&Mat::<f64>::identity(size, size));
+        let norm1 = |m: &Mat<f64>| {
+            (0..m.ncols()).map(|c| (0..m.nrows()).map(|r| m[(r, c)].abs()).sum::<f64>()).fold(0.0, crate::num::max_nan)
+        };
+        let cond = norm1(&a) * norm1(&inv);
+        if !(cond.is_finite() && cond <= ULTRA_COND_LIMIT) {
+            return Ok(Err(OdeError::Singular { cond, detail: " (ultraspherical system)".into() }));
+        }
+        let base: Vec<Vec<f64>> = (0..n).map(|i| (0..size).map(|m| x[(m, i)]).collect()).collect();
+        // resolved: the last four coefficients are negligible against the largest
+        for c in &base {
+            let big = c.iter().fold(0.0, |m: f64, x| crate::num::max_nan(m, x.abs()));
+            let tail = c[size - 4..].iter().fold(0.0, |m: f64, x| crate::num::max_nan(m, x.abs()));
+            if !(big.is_finite() && tail <= 1e-14 * big) {
+                return Err(Unresolved);
+            }
+        }
+        // derivative series in u (each x-derivative times 2)
+        let mut coef = vec![base.clone()];
+        for k in 0..kmax {
+            let next: Vec<Vec<f64>> =
+                coef[k].iter().map(|c| differentiate(c).into_iter().map(|x| 2.0 * x).collect()).collect();
+            coef.push(next);
+        }
+        let mut at_conditions: Vec<(f64, Vec<Vec<f64>>)> = Vec::new();
+        for cd in conds {
+            if at_conditions.iter().any(|(u, _)| *u == cd.u) {
+                continue;
+            }
+            let t = chebyshev_derivatives(2.0 * cd.u - 1.0, size, kmax);
+            let rows = (0..=kmax)
+                .map(|k| {
+                    let s = 2f64.powi(k as i32);
+                    base.iter().map(|c| s * c.iter().zip(&t[k]).map(|(a, tk)| a * tk).sum::<f64>()).collect()
+                })
+                .collect();
+            at_conditions.push((cd.u, rows));
+        }
+        let out = UltraCardinal { coef, kmax, dim: n, cond, size, at_conditions };
+        // the cardinal property at the conditions, to round-off
+        for (i, cd) in conds.iter().enumerate() {
+            if cd.order > kmax {
+                continue;
+            }
+            let e = out.eval(cd.u, cd.order);
+            let scale = out.coef[cd.order]
+                .iter()
+                .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
+                .fold(1.0, crate::num::max_nan);
+            for (k, &val) in e[cd.order].iter().enumerate() {
+                let want = f64::from(k == i);
+                if !((val - want).abs() <= 1e-12 * scale) {
+                    return Ok(Err(OdeError::Singular {
+                        cond,
+                        detail: format!(
+                            ": ultraspherical cardinal function {k} misses condition {i} by {:.1e}",
+                            val - want
+                        ),
+                    }));
+                }
+            }
+        }
+        Ok(Ok(out))
+    }
+
+    /// `out[k][i] = ℓ_i^{(k)}(u)`, `k ≤ kmax` (at most the tabulated order).
+    pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
+        assert!(kmax <= self.kmax, "derivative order {kmax} not tabulated (max {})", self.kmax);
+        if let Some((_, rows)) = self.at_conditions.iter().find(|(c, _)| *c == u) {
+            return rows[..=kmax].to_vec();
+        }
+        let t = 2.0 * u - 1.0;
+        (0..=kmax).map(|k| (0..self.dim).map(|i| clenshaw(&self.coef[k][i], t)).collect()).collect()
+    }
+
+    /// Highest tabulated derivative order.
+    pub fn kmax(&self) -> usize {
+        self.kmax
+    }
+
+    /// Condition number `‖A‖₁‖A⁻¹‖₁` of the row-scaled system.
+    pub fn condition_number(&self) -> f64 {
+        self.cond
+    }
+
+    /// Chebyshev coefficients per function.
+    pub fn terms(&self) -> usize {
+        self.size
+    }
+}
+
+/// The series needs more terms.
+struct Unresolved;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chebyshev_helpers_match_closed_forms() {
+        // T_3 = 4x³ − 3x: T_3′ = 12x² − 3, T_3″ = 24x
+        let t = chebyshev_derivatives(0.3, 5, 2);
+        assert!((t[0][3] - (4.0 * 0.027 - 0.9)).abs() < 1e-15);
+        assert!((t[1][3] - (12.0 * 0.09 - 3.0)).abs() < 1e-14);
+        assert!((t[2][3] - 7.2).abs() < 1e-14);
+        // d/dx (T_2 + T_3) = 4x + 12x² − 3 = 4 T_1 + 6 T_2 + 3 T_0
+        let d = differentiate(&[0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(d, vec![3.0, 4.0, 6.0, 0.0]);
+        assert!((clenshaw(&[3.0, 4.0, 6.0], 0.3) - (4.0 * 0.3 + 12.0 * 0.09 - 3.0)).abs() < 1e-14);
+    }
+
+    /// Order 40 at small rates, where the exponential basis needs multiple precision: the
+    /// ultraspherical system is well conditioned and its functions are cardinal.
+    #[test]
+    fn order_forty_is_well_conditioned() {
+        for c in [0.0, 0.3, 1.0, 5.0, 18.0] {
+            let nodes: Vec<CondSpec> = (0..40)
+                .map(|i| CondSpec { u: (1.0 - (std::f64::consts::PI * i as f64 / 39.0).cos()) / 2.0, order: 0 })
+                .collect();
+            let u = UltraCardinal::new(&ExpSpace::symmetric(c, 20), &nodes, 2).unwrap();
+            assert!(u.condition_number() < 1e4, "c = {c}: {:e}", u.condition_number());
+            for (i, cd) in nodes.iter().enumerate() {
+                let e = u.eval(cd.u, 0);
+                for (k, x) in e[0].iter().enumerate() {
+                    assert!((x - f64::from(k == i)).abs() < 1e-13, "c = {c}: ℓ_{k}(u_{i}) = {x}");
+                }
+            }
+        }
+    }
+}
