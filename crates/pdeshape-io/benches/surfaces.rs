@@ -70,6 +70,20 @@ fn surfaces(c: &mut Criterion) {
             Scene::parse(&text, "b", "b", &params).unwrap()
         })
     });
+    // SPEC §10: the Klein bottle (order 40), cold solve for a new `a` + 200 × 200 with
+    // normals (target 10 ms)
+    let klein_text =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/klein-bottle.toml"))
+            .unwrap();
+    let mut ka = fresh(1.0);
+    g.bench_function("klein order 40: solve (new a) + 200x200 with normals", |b| {
+        b.iter(|| {
+            let params = std::collections::HashMap::from([("a".to_string(), ka())]);
+            let s = Scene::parse(&klein_text, "k", "k", &params).unwrap();
+            let p = s.patches[0].spectral.clone().expect("a PDE patch");
+            grid_mesh(p.as_ref(), &GridOptions::new(200, 200)).expect("finite")
+        })
+    });
     g.finish();
 
     // SPEC §10: paper 002 eq. 19 at one t, 100 × 100 points with normals: the closed form
