@@ -12,6 +12,9 @@ use serde_json::{Value, json};
 
 /// Number of `v` samples per condition in the exactness check (SPEC §3: ≥ 1000).
 pub const CHECK_SAMPLES: usize = 1000;
+/// A relative condition error above this is reported as a warning (the solvers meet their
+/// conditions to round-off, about 1e-15 … 1e-12).
+pub const CONDITION_WARNING: f64 = 1e-8;
 
 /// Meshes one patch at its resolution, with its position conditions as highlighted
 /// curves. Fails when the patch is not finite somewhere.
@@ -728,6 +731,26 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     }
     if !dyn_json.is_null() {
         d["dynamic"] = dyn_json;
+    }
+    if rep.max_rel.is_finite()
+        && rep.max_rel > CONDITION_WARNING
+        && let Some(w) = d["warnings"].as_array_mut()
+    {
+        w.push(json!(format!(
+            "the patch meets its conditions only to {:.2e} (relative): the data are not resolved on this domain \
+             (data varying much faster than the modes, or an extreme domain); the result does not interpolate them",
+            rep.max_rel
+        )));
+    }
+    if let Some(dy) = &p.dynamic
+        && dy.blend.operator().beta == 0.0
+        && let Some(w) = d["warnings"].as_array_mut()
+    {
+        w.push(json!(
+            "beta = 0: the operator has no ∂⁴/∂u⁴ term, so it cannot take the four C1 conditions; they are met by \
+             the trial functions (cubic Hermite part) and the sine terms only minimise the residual of a 2nd-order \
+             operator in u: the closed form does not apply and the shape depends on the collocation grid and K"
+        ));
     }
     if let Some(sp) = &p.spectral {
         let r = sp.report();

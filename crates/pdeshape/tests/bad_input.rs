@@ -549,6 +549,16 @@ mod hostile {
         assert!(!out.exists());
         let (code, _, err) = run(&["check", &p], "");
         assert_eq!(code, 1, "{err}");
+        // finite but not interpolating (cos v over [0, 1e300]): `check` warns with the figure
+        let p = scene_file(
+            &dir,
+            &text
+                .replace("expr = [\"v\", \"0\", \"0\"]", "expr = [\"cos(v)\", \"sin(v)\", \"0\"]")
+                .replace("expr = [\"v\", \"0\", \"1\"]", "expr = [\"cos(v)\", \"sin(v)\", \"1\"]"),
+        );
+        let (code, out, err) = run(&["check", &p], "");
+        assert_eq!(code, 0, "{err}");
+        assert!(out.contains("warning: the patch meets its conditions only to"), "{out}");
     }
 
     /// Small ones: an overflowing cap value, a 200 KB line echoed twice on stderr, an

@@ -141,3 +141,20 @@ fn build_writes_an_animated_gltf_and_a_frame_sequence() {
         assert!(f.exists(), "{} missing", f.display());
     }
 }
+
+/// Regression: `beta = 0` (paper 002 Fig. 5 uses it) was accepted without a word. It still
+/// builds (the collocation solver's trial functions carry the conditions) and says why the
+/// result is not the solution of a 4th-order problem; the closed form refuses it.
+#[test]
+fn beta_zero_is_reported() {
+    let text = std::fs::read_to_string(example("dynamic-elliptic-cylinders.toml")).unwrap();
+    let params = std::collections::HashMap::from([("beta".to_string(), 0.0)]);
+    let scene = Scene::parse(&text, "d.toml", "d", &params).unwrap();
+    let d = model::patch_diagnostics(&scene.patches[0]);
+    assert_eq!(d["solver"], "collocation");
+    let w = d["warnings"].as_array().unwrap();
+    assert!(w.iter().any(|w| w.as_str().unwrap().starts_with("beta = 0")), "{w:?}");
+    let opts = pdeshape_io::scene::LoadOptions { params, solver: Some("exact".into()), ..Default::default() };
+    let e = Scene::parse_with(&text, "d.toml", "d", &opts).unwrap_err();
+    assert!(e.to_string().contains("β = 0"), "{e}");
+}
