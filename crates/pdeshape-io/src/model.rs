@@ -483,7 +483,8 @@ pub fn condition_report(p: &ScenePatch) -> pdeshape_core::patch::ConditionReport
                     pdeshape_core::patch::ConditionReport { max_abs: f64::NAN, max_rel: f64::NAN, size: f64::NAN }
                 }
             };
-            if !(r.max_rel < worst.max_rel) {
+            // the worst frame; a NaN frame is the worst of all
+            if r.max_rel.is_nan() || r.max_rel >= worst.max_rel {
                 worst = r;
             }
         }

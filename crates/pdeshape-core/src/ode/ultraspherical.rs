@@ -262,7 +262,9 @@ impl UltraCardinal {
                 .fold(1.0, crate::num::max_nan);
             for (k, &val) in e[cd.order].iter().enumerate() {
                 let want = f64::from(k == i);
-                if !((val - want).abs() <= 1e-12 * scale) {
+                // written so that a NaN fails too
+                let ok = (val - want).abs() <= 1e-12 * scale;
+                if !ok {
                     return Ok(Err(OdeError::Singular {
                         cond,
                         detail: format!(
