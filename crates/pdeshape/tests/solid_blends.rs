@@ -37,14 +37,7 @@ fn solid_examples_meet_conditions_and_have_closed_boundaries() {
                 "{name}: edge ({a}, {b}) is not shared by exactly two triangles"
             );
         }
-        let enclosed: f64 = m
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| m.positions[i as usize]);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum();
+        let enclosed: f64 = m.enclosed_volume();
         let vol = d["mass_properties"]["volume"].as_f64().unwrap();
         assert!(enclosed > 0.0 && (enclosed - vol).abs() < 0.03 * vol, "{name}: mesh {enclosed} vs quadrature {vol}");
     }
@@ -85,14 +78,7 @@ fn cube_volume_matches_the_analytic_integral() {
         let (f0, f1, g0, g1) = (poly(&f, w0), poly(&f, w1), poly(&g, w0), poly(&g, w1));
         want += 8.0 * (w1 - w0) * (2.0 * f0 * g0 + f0 * g1 + f1 * g0 + 2.0 * f1 * g1) / 6.0;
     }
-    let enclosed: f64 = m
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| m.positions[i as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum();
+    let enclosed: f64 = m.enclosed_volume();
     // a sum of a few thousand O(1) tetrahedra: round-off
     assert!((enclosed - want).abs() < 1e-12 * want, "mesh encloses {enclosed}, the polyhedron {want}");
 }

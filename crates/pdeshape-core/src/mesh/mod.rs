@@ -70,6 +70,30 @@ impl Mesh {
         t
     }
 
+    /// The volume a closed, outward-oriented triangle mesh encloses, by the divergence
+    /// theorem: `Σ a · (b × c) / 6` over its triangles (quads split as in
+    /// [`all_triangles`](Self::all_triangles)). Negative for an inward orientation.
+    ///
+    /// ```
+    /// use pdeshape_core::{Vec3, mesh::Mesh};
+    /// // the unit tetrahedron, faces outward: volume 1/6
+    /// let m = Mesh {
+    ///     positions: vec![Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.0, 1.0)],
+    ///     triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    ///     ..Default::default()
+    /// };
+    /// assert!((m.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
+    /// ```
+    pub fn enclosed_volume(&self) -> f64 {
+        self.all_triangles()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
     /// Axis-aligned bounds `(min, max)`; `None` for an empty mesh.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut it = self.positions.iter();

@@ -249,14 +249,7 @@ mod tests {
             let m = boundary_mesh(&s, (9, 17, 9));
             closed_and_oriented(&m).unwrap();
             // outward: the enclosed volume by the divergence theorem matches the quadrature
-            let vol: f64 = m
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|i| m.positions[i as usize]);
-                    a.dot(b.cross(c)) / 6.0
-                })
-                .sum();
+            let vol: f64 = m.enclosed_volume();
             let mp = s.mass_properties(12);
             assert!(vol > 0.0 && (vol - mp.volume).abs() < 0.05 * mp.volume, "{vol} vs {}", mp.volume);
         }
