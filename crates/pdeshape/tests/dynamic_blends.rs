@@ -106,8 +106,8 @@ fn sample_any_time_equals_the_closed_form() {
         // O(1) values from a well-conditioned 4 × 4 fit: round-off
         assert!(err_exact < 1e-12, "t = {t}: exact solver vs closed form {err_exact:e}");
         // SPEC §5: the K = 5 approximation is off by a few 1e-3 (G_1 alone: 4.4e-3 at the
-        // collocation points); measured here: see the message
-        assert!(err_approx > 1e-4 && err_approx < 1e-2, "t = {t}: K = 5 vs closed form {err_approx:e}");
+        // collocation points); measured here 3.1e-3, 4.1e-3, 4.9e-3 at t = 0, 0.17, 0.3
+        assert!(err_approx > 2e-3 && err_approx < 6e-3, "t = {t}: K = 5 vs closed form {err_approx:e}");
     }
 }
 
