@@ -60,7 +60,8 @@ fn load(url: &str, text: &str, param: &str, values: &[f64], clients: usize, chan
 fn expected(text: &str, param: &str, v: f64) -> String {
     use std::sync::{Mutex, OnceLock};
     // keyed by the scene text too: the tests of this file run in parallel on different scenes
-    static CACHE: OnceLock<Mutex<HashMap<(String, String, u64), String>>> = OnceLock::new();
+    type Key = (String, String, u64);
+    static CACHE: OnceLock<Mutex<HashMap<Key, String>>> = OnceLock::new();
     let key = (text.to_string(), param.to_string(), v.to_bits());
     let cache = CACHE.get_or_init(Default::default);
     if let Some(h) = cache.lock().unwrap().get(&key) {
