@@ -224,7 +224,7 @@ proptest! {
         let b = StaticBlend::new(ops, &conds, VDomain::PERIODIC, &BlendOptions::default()).unwrap();
         prop_assert!(b.reports().iter().all(|r| r.solver == "exact"));
         let err = condition_error(&b, &conds);
-        let size = conds.iter().map(|c| (0..50).map(|i| c.data.eval(&[i as f64 * 0.13, 0.0]).norm()).max_nan()).fold(1.0, f64::max);
+        let size = conds.iter().map(|c| (0..50).map(|i| c.data.eval(&[i as f64 * 0.13, 0.0]).norm()).max_nan()).fold(1.0, crate::num::max_nan);
         prop_assert!(err < 1e-10 * size, "condition error {}", err);
         let (res, rsize) = max_residual(&b);
         prop_assert!(res < 1e-10 * rsize.max(1.0), "PDE residual {} of {}", res, rsize);

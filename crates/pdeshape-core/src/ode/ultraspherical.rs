@@ -146,7 +146,7 @@ impl UltraCardinal {
             .enumerate()
             .map(|(k, pk)| if *pk == 0.0 { f64::NEG_INFINITY } else { pk.abs().log2() + k as f64 + log2_dk(k) })
             .collect();
-        let top = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let top = logs.iter().copied().fold(f64::NEG_INFINITY, crate::num::max_nan);
         let factor = |k: usize| if logs[k].is_finite() { p[k].signum() * (logs[k] - top).exp2() } else { 0.0 };
         // Horner in the C^{(λ)} bases, (K + 2n) rows so that no conversion is truncated
         let rows = size + 2 * n;
@@ -186,7 +186,7 @@ impl UltraCardinal {
             let t = chebyshev_derivatives(2.0 * cd.u - 1.0, size, cd.order);
             let scale = 2f64.powi(cd.order as i32);
             let row: Vec<f64> = t[cd.order].iter().map(|x| x * scale).collect();
-            let mx = row.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+            let mx = row.iter().fold(0.0, |m: f64, x| crate::num::max_nan(m, x.abs()));
             if !(mx.is_finite() && mx > 0.0) {
                 return Ok(Err(OdeError::Singular {
                     cond: f64::INFINITY,
@@ -199,7 +199,7 @@ impl UltraCardinal {
             b[(i, i)] = 1.0 / mx;
         }
         for j in 0..size - n {
-            let mx = r[j].iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+            let mx = r[j].iter().fold(0.0, |m: f64, x| crate::num::max_nan(m, x.abs()));
             if !mx.is_finite() {
                 return Ok(Err(OdeError::Singular { cond: f64::INFINITY, detail: ": operator rows overflow".into() }));
             }
