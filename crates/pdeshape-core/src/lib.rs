@@ -29,6 +29,7 @@ pub mod ode;
 pub mod patch;
 pub mod solid;
 pub mod spectral;
+pub mod taylor;
 pub mod trim;
 mod vec3;
 

@@ -2,11 +2,13 @@
 
 use super::{Field, VecJet};
 use crate::Vec3;
-use crate::expr::{Expr, ExprError};
+use crate::expr::{Expr, ExprError, Tape};
 use crate::jet::{Jet, JetShape};
+use crate::taylor::Taylor;
 
 /// A vector field `(x(p), y(p), z(p))` given by three bound expressions in the variables
-/// `vars` (slot order).
+/// `vars` (slot order), compiled once into one [`Tape`] (sub-expressions shared between the
+/// components are evaluated once).
 ///
 /// ```
 /// use pdeshape_core::data::{ExprField, Field};
@@ -20,6 +22,7 @@ use crate::jet::{Jet, JetShape};
 pub struct ExprField {
     comps: [Expr; 3],
     vars: Vec<String>,
+    tape: Tape,
 }
 
 impl ExprField {
@@ -35,12 +38,13 @@ impl ExprField {
             comps.push(e.bind(vars, param).map_err(|e| (i, e.with_source(s)))?);
         }
         let comps: [Expr; 3] = comps.try_into().expect("three components");
-        Ok(ExprField { comps, vars: vars.iter().map(|s| s.to_string()).collect() })
+        Ok(ExprField::from_exprs(comps, vars))
     }
 
     /// A field from three already bound expressions.
     pub fn from_exprs(comps: [Expr; 3], vars: &[&str]) -> Self {
-        ExprField { comps, vars: vars.iter().map(|s| s.to_string()).collect() }
+        let tape = Tape::compile(&[&comps[0], &comps[1], &comps[2]]);
+        ExprField { comps, vars: vars.iter().map(|s| s.to_string()).collect(), tape }
     }
 
     /// The component expressions.
@@ -51,6 +55,18 @@ impl ExprField {
     /// The variable names, in slot order.
     pub fn vars(&self) -> &[String] {
         &self.vars
+    }
+
+    /// `∂ᵏ/∂(slot)ᵏ` for `k < out.len() ≤ N` by the tape in Taylor series of length `N`.
+    fn taylor<const N: usize>(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        let vars: Vec<Taylor<N>> = (0..self.vars.len())
+            .map(|i| if i == slot { Taylor::variable(at[i]) } else { Taylor::constant(at[i]) })
+            .collect();
+        let mut regs = Vec::new();
+        let o = self.tape.eval(&vars, &Taylor::constant(0.0), &mut regs);
+        for (k, d) in out.iter_mut().enumerate() {
+            *d = Vec3::new(o[0].derivative(k), o[1].derivative(k), o[2].derivative(k));
+        }
     }
 }
 
@@ -64,12 +80,28 @@ impl Field for ExprField {
 
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
         let vars: Vec<Jet> = (0..self.vars.len()).map(|i| Jet::variable(shape, i, at[i])).collect();
-        VecJet(std::array::from_fn(|k| self.comps[k].eval_jet(&vars)))
+        let like = Jet::constant(shape, 0.0);
+        let mut regs = Vec::new();
+        let mut out = self.tape.eval(&vars, &like, &mut regs);
+        VecJet(std::array::from_fn(|_| out.next().cloned().expect("three outputs")))
     }
 
     fn eval(&self, at: &[f64]) -> Vec3 {
-        let at = &at[..self.vars.len()];
-        Vec3::new(self.comps[0].eval(at), self.comps[1].eval(at), self.comps[2].eval(at))
+        let mut regs = Vec::new();
+        let o = self.tape.eval(&at[..self.vars.len()], &0.0, &mut regs);
+        Vec3::new(o[0], o[1], o[2])
+    }
+
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        match out.len() {
+            0 => {}
+            1 => out[0] = self.eval(at),
+            2 => self.taylor::<2>(at, slot, out),
+            3 => self.taylor::<3>(at, slot, out),
+            4 => self.taylor::<4>(at, slot, out),
+            5..=8 => self.taylor::<8>(at, slot, out),
+            _ => super::derivatives_by_jet(self, at, slot, out),
+        }
     }
 
     fn is_constant_in(&self, slot: usize) -> bool {

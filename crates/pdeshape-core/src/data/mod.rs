@@ -81,6 +81,13 @@ pub trait Field: Send + Sync + Debug {
         self.jet(at, JetShape::scalar()).value()
     }
 
+    /// `∂ᵏF/∂(slot)ᵏ` at `at` for `k = 0 … out.len() − 1`, exactly (the other slots held
+    /// fixed). Expression fields answer from their compiled tape in fixed-length Taylor
+    /// series; the default goes through [`jet`](Self::jet).
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        derivatives_by_jet(self, at, slot, out)
+    }
+
     /// True when the field does not depend on slot `slot` (e.g. time for a B-spline).
     fn is_constant_in(&self, _slot: usize) -> bool {
         false
@@ -90,6 +97,19 @@ pub trait Field: Send + Sync + Debug {
     /// expressions (used to expand boundary data into basis functions, SPEC §5).
     fn expressions(&self) -> Option<(&[crate::expr::Expr; 3], &[String])> {
         None
+    }
+}
+
+/// [`Field::derivatives_in`] through a jet of order `out.len() − 1` in `slot`.
+pub fn derivatives_by_jet<F: Field + ?Sized>(f: &F, at: &[f64], slot: usize, out: &mut [Vec3]) {
+    let Some(order) = out.len().checked_sub(1) else { return };
+    let mut orders = [0; MAX_VARS];
+    orders[slot] = order;
+    let j = f.jet(at, JetShape::new(&orders));
+    for (k, d) in out.iter_mut().enumerate() {
+        let mut m = [0; MAX_VARS];
+        m[slot] = k;
+        *d = j.derivative(m);
     }
 }
 

@@ -42,11 +42,11 @@ pub(super) fn apply_f64(f: Func, a: &[f64]) -> f64 {
     }
 }
 
-fn pow_f64(x: f64, y: f64) -> f64 {
+pub(super) fn pow_f64(x: f64, y: f64) -> f64 {
     if y == y.round() && y.abs() <= 64.0 { x.powi(y as i32) } else { x.powf(y) }
 }
 
-fn apply_jet(f: Func, a: &[Jet]) -> Jet {
+pub(super) fn apply_jet(f: Func, a: &[Jet]) -> Jet {
     match f {
         Func::Sin => a[0].sin(),
         Func::Cos => a[0].cos(),

@@ -23,9 +23,11 @@
 mod eval;
 mod expand;
 mod parse;
+mod tape;
 
 pub use expand::{Term, expand};
 pub use parse::ExprError;
+pub use tape::{OutputIter, Tape, TapeNum};
 
 use std::fmt;
 
