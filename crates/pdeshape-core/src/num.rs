@@ -38,6 +38,26 @@ pub trait MaxNan: Iterator<Item = f64> + Sized {
 
 impl<I: Iterator<Item = f64>> MaxNan for I {}
 
+/// `Σ aᵢbᵢ` over the common length, with four partial sums so the products pipeline (the
+/// order of summation differs from a left-to-right loop by round-off only).
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for j in 0..4 {
+            s[j] += x[j] * y[j];
+        }
+    }
+    let mut r = (s[0] + s[1]) + (s[2] + s[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        r += x * y;
+    }
+    r
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,10 +26,10 @@
 use crate::Vec3;
 use crate::data::fourier::{FourierSeries, sample_count};
 use crate::data::{EvenExtension, FieldRef};
-use crate::jet::JetShape;
 use crate::num::MaxNan;
 use crate::ode::{CardinalSet, CondSpec, ExpSpace, OdeError};
 use crate::patch::{Condition, Surface, VDomain};
+use faer::Mat;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -337,14 +337,14 @@ impl SpectralPatch {
 
     /// [`tails`](Self::tails) with `cs = trig(θ)` given.
     fn tails_with(&self, theta: f64, cs: &[(f64, f64)], jmax: usize) -> Vec<Vec<Vec3>> {
-        let shape = JetShape::new(&[jmax]);
         self.data
             .iter()
             .zip(&self.series)
             .map(|(g, s)| {
-                let jet = g.jet(&[theta, self.time], shape);
+                let mut d = vec![Vec3::ZERO; jmax + 1];
+                g.derivatives_in(&[theta, self.time], 0, &mut d);
                 let series = s.derivatives_from(cs, jmax);
-                (0..=jmax).map(|j| jet.derivative([j, 0, 0]) - series[j]).collect()
+                d.iter().zip(&series).map(|(&x, &f)| x - f).collect()
             })
             .collect()
     }
@@ -451,63 +451,11 @@ impl Surface for SpectralPatch {
     }
 
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
-        // Per column: cos nθ, sin nθ and the tails with their θ-derivative; per row: the
-        // mode functions and their u-derivative. Each point is then a dense sum.
-        let m = self.opts.modes;
-        let k = self.dtheta_dv;
-        self.grid_rows(us, vs, 1, |row, col| {
-            let (mut p, mut pu, mut pv, mut puv) = (row.a[0][0], row.a[1][0], Vec3::ZERO, Vec3::ZERO);
-            for n in 1..=m {
-                let (c, s) = col.cs[n];
-                let nf = n as f64;
-                let (a0, b0, a1, b1) = (row.a[0][n], row.b[0][n], row.a[1][n], row.b[1][n]);
-                p += a0 * c + b0 * s;
-                pu += a1 * c + b1 * s;
-                pv += (b0 * c - a0 * s) * nf;
-                puv += (b1 * c - a1 * s) * nf;
-            }
-            for (ci, t) in col.tails.iter().enumerate() {
-                let (l0, l1) = (row.l[0][ci], row.l[1][ci]);
-                p += t[0] * l0;
-                pu += t[0] * l1;
-                pv += t[1] * l0;
-                puv += t[1] * l1;
-            }
-            [p, pu, pv * k, puv * k]
-        })
+        self.grid_products(us, vs, [(0, 0), (1, 0), (0, 1), (1, 1)])
     }
 
     fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
-        // as `grid`, with the second derivatives: ∂θ² of cos nθ, sin nθ is −n² times them
-        let m = self.opts.modes;
-        let (k, k2) = (self.dtheta_dv, self.dtheta_dv * self.dtheta_dv);
-        self.grid_rows(us, vs, 2, |row, col| {
-            let [mut p, mut pu, mut puu] = [row.a[0][0], row.a[1][0], row.a[2][0]];
-            let [mut pv, mut puv, mut pvv] = [Vec3::ZERO; 3];
-            for n in 1..=m {
-                let (c, s) = col.cs[n];
-                let nf = n as f64;
-                let (a0, b0) = (row.a[0][n], row.b[0][n]);
-                let (a1, b1) = (row.a[1][n], row.b[1][n]);
-                let value = a0 * c + b0 * s;
-                p += value;
-                pu += a1 * c + b1 * s;
-                puu += row.a[2][n] * c + row.b[2][n] * s;
-                pv += (b0 * c - a0 * s) * nf;
-                puv += (b1 * c - a1 * s) * nf;
-                pvv -= value * (nf * nf);
-            }
-            for (ci, t) in col.tails.iter().enumerate() {
-                let (l0, l1, l2) = (row.l[0][ci], row.l[1][ci], row.l[2][ci]);
-                p += t[0] * l0;
-                pu += t[0] * l1;
-                puu += t[0] * l2;
-                pv += t[1] * l0;
-                puv += t[1] * l1;
-                pvv += t[2] * l0;
-            }
-            [p, pu, pv * k, puu, puv * k, pvv * k2]
-        })
+        self.grid_products(us, vs, [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)])
     }
 }
 
@@ -519,26 +467,96 @@ struct GridColumn {
 }
 
 impl SpectralPatch {
-    /// The grid `us × vs` (row-major in `u`) of `point(row, column)`: the column data up
-    /// to the `jmax`-th θ-derivative once per `v`, the mode functions up to the `jmax`-th
-    /// u-derivative once per `u`; rows are filled in parallel into one output buffer.
-    fn grid_rows<const D: usize>(
-        &self,
-        us: &[f64],
-        vs: &[f64],
-        jmax: usize,
-        point: impl Fn(&Row, &GridColumn) -> [Vec3; D] + Sync,
-    ) -> Vec<[Vec3; D]> {
-        let cols = self.grid_columns(vs, jmax);
-        let mut out = vec![[Vec3::ZERO; D]; us.len() * vs.len()];
-        if vs.is_empty() {
+    /// `∂^{i+j}X/∂uⁱ∂vʲ` for each `(i, j)` of `orders` on the grid `us × vs` (row-major in
+    /// `u`), as dense matrix products. Per component `x`,
+    ///
+    /// `∂uⁱ∂θʲ X_x = Rᵢ · Qⱼ`, `Rᵢ = [a⁽ⁱ⁾₀ₓ(u) | a⁽ⁱ⁾ₙₓ(u) | b⁽ⁱ⁾ₙₓ(u) | ℓ⁽ⁱ⁾_c(u)]` (a row per `u`),
+    /// `Qⱼ = [δⱼ₀ ; ∂θʲ cos nθ ; ∂θʲ sin nθ ; r⁽ʲ⁾_{c,x}(θ)]` (a column per `v`),
+    ///
+    /// with `n = 1 … M` and `c` the conditions (the remainder's cardinal functions times the
+    /// Fourier tails). The mode functions are computed once per `u`, the data once per `v`;
+    /// the products run in faer's GEMM, one per order and component, in parallel.
+    fn grid_products<const D: usize>(&self, us: &[f64], vs: &[f64], orders: [(usize, usize); D]) -> Vec<[Vec3; D]> {
+        let (nu, nv) = (us.len(), vs.len());
+        let mut out = vec![[Vec3::ZERO; D]; nu * nv];
+        if nu == 0 || nv == 0 {
             return out;
         }
-        out.par_chunks_mut(vs.len()).zip(us.par_iter()).for_each(|(dst, &u)| {
-            crate::cancel::checkpoint();
-            let row = self.row(u, jmax);
-            for (o, col) in dst.iter_mut().zip(&cols) {
-                *o = point(&row, col);
+        let imax = orders.iter().map(|o| o.0).max().unwrap_or(0);
+        let jmax = orders.iter().map(|o| o.1).max().unwrap_or(0);
+        let cols = self.grid_columns(vs, jmax);
+        let rows: Vec<Arc<Row>> = us
+            .par_iter()
+            .map(|&u| {
+                crate::cancel::checkpoint();
+                self.row(u, imax)
+            })
+            .collect();
+        let (m, nc) = (self.opts.modes, self.conds.len());
+        let width = 1 + 2 * m + nc;
+        let r_mat = |i: usize, x: usize| {
+            Mat::<f64>::from_fn(nu, width, |ui, f| {
+                let row = &rows[ui];
+                match f {
+                    0 => row.a[i][0][x],
+                    f if f <= m => row.a[i][f][x],
+                    f if f <= 2 * m => row.b[i][f - m][x],
+                    f => row.l[i][f - 1 - 2 * m],
+                }
+            })
+        };
+        let q_mat = |j: usize, x: usize| {
+            let k = self.dtheta_dv.powi(j as i32);
+            Mat::<f64>::from_fn(width, nv, |f, vi| {
+                let col = &cols[vi];
+                let trig = |n: usize, sine: bool| {
+                    // ∂θʲ (cos nθ, sin nθ) = nʲ (cos, sin)(nθ + jπ/2): a quarter turn per order
+                    let (c, s) = col.cs[n];
+                    let (c, s) = match j % 4 {
+                        0 => (c, s),
+                        1 => (-s, c),
+                        2 => (-c, -s),
+                        _ => (s, -c),
+                    };
+                    (n as f64).powi(j as i32) * if sine { s } else { c }
+                };
+                k * match f {
+                    0 => f64::from(j == 0),
+                    f if f <= m => trig(f, false),
+                    f if f <= 2 * m => trig(f - m, true),
+                    f => col.tails[f - 1 - 2 * m][j][x],
+                }
+            })
+        };
+        // R and Q once per order and component; the products transposed (`Pᵀ = Qᵀ Rᵀ`, a
+        // column per `u`) so that each grid row is read as a contiguous column.
+        let rs: Vec<Mat<f64>> = (0..(imax + 1) * 3).into_par_iter().map(|t| r_mat(t / 3, t % 3)).collect();
+        let qs: Vec<Mat<f64>> = (0..(jmax + 1) * 3).into_par_iter().map(|t| q_mat(t / 3, t % 3)).collect();
+        let products: Vec<Mat<f64>> = (0..D * 3)
+            .into_par_iter()
+            .map(|t| {
+                crate::cancel::checkpoint();
+                let (d, x) = (t / 3, t % 3);
+                let (i, j) = orders[d];
+                let (r, q) = (&rs[i * 3 + x], &qs[j * 3 + x]);
+                let mut pt = Mat::<f64>::zeros(nv, nu);
+                faer::linalg::matmul::matmul(
+                    pt.as_mut(),
+                    faer::Accum::Replace,
+                    q.transpose(),
+                    r.transpose(),
+                    1.0,
+                    faer::Par::Seq,
+                );
+                pt
+            })
+            .collect();
+        out.par_chunks_mut(nv).enumerate().for_each(|(ui, dst)| {
+            for (t, pt) in products.iter().enumerate() {
+                let (d, x) = (t / 3, t % 3);
+                for (o, &v) in dst.iter_mut().zip(pt.col_as_slice(ui)) {
+                    o[d][x] = v;
+                }
             }
         });
         out

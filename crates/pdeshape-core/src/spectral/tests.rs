@@ -3,6 +3,7 @@
 use super::*;
 use crate::data::FnField;
 use crate::jet::Jet;
+use crate::jet::JetShape;
 use crate::patch::check_conditions;
 use proptest::prelude::*;
 
