@@ -477,6 +477,18 @@ impl SpectralPatch {
     /// Fourier tails). The mode functions are computed once per `u`, the data once per `v`;
     /// the products run in faer's GEMM, one per order and component, in parallel.
     fn grid_products<const D: usize>(&self, us: &[f64], vs: &[f64], orders: [(usize, usize); D]) -> Vec<[Vec3; D]> {
+        // One entry into the thread pool for the whole grid: called from outside the pool,
+        // each parallel step below would otherwise be a separate hand-over to the workers
+        // (a wake-up each, measurable on 100 × 100 grids).
+        rayon::scope(|_| self.grid_products_in_pool(us, vs, orders))
+    }
+
+    fn grid_products_in_pool<const D: usize>(
+        &self,
+        us: &[f64],
+        vs: &[f64],
+        orders: [(usize, usize); D],
+    ) -> Vec<[Vec3; D]> {
         let (nu, nv) = (us.len(), vs.len());
         let mut out = vec![[Vec3::ZERO; D]; nu * nv];
         if nu == 0 || nv == 0 {
