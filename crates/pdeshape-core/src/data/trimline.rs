@@ -1,6 +1,7 @@
 //! Boundary conditions taken from a primary surface along a trimline (SPEC §2.3).
 
 use super::{Field, FieldRef, VecJet};
+use crate::Vec3;
 use crate::jet::{Jet, JetShape};
 
 /// The curve `g(v, t) = κᵈ ∂ᵈS/∂sᵈ (s₀, v, t)` cut from a primary surface `S(s, v, t)` at
@@ -58,8 +59,63 @@ impl Field for Trimline {
             Jet::from_coeffs(shape, c)
         }))
     }
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        let t = at.get(1).copied().unwrap_or(0.0);
+        let on_surface = [self.s0, at[0], t];
+        let d = self.order;
+        if d == 0 {
+            // the surface's own derivatives along the matching slot
+            self.surface.derivatives_in(&on_surface, slot + 1, out);
+        } else if out.len() == 1 {
+            // the value of the d-th cross derivative: along s at fixed (v, t)
+            let mut along_s = vec![Vec3::ZERO; d + 1];
+            self.surface.derivatives_in(&on_surface, 0, &mut along_s);
+            out[0] = along_s[d] * self.scale.powi(d as i32);
+        } else {
+            super::derivatives_by_jet(self, at, slot, out);
+        }
+    }
     fn is_constant_in(&self, slot: usize) -> bool {
         // slot 0 of the trimline is the surface's slot 1, and so on.
         self.surface.is_constant_in(slot + 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{ExprField, derivatives_by_jet};
+    use std::sync::Arc;
+
+    /// The fast paths (tape in Taylor series along one slot) against the jets, and a
+    /// closed form: on S(s, v, t) = (s² cos v, s² sin v, t s) the first cross derivative at
+    /// s₀ scaled by c is c·(2 s₀ cos v, 2 s₀ sin v, t), its v-derivatives follow by hand.
+    #[test]
+    fn derivatives_along_one_slot_match_jets_and_closed_forms() {
+        let s: FieldRef =
+            Arc::new(ExprField::parse(["s^2*cos(v)", "s^2*sin(v)", "t*s"], &["s", "v", "t"], &|_| None).unwrap());
+        let (s0, c, v, t) = (1.3, 0.7, 0.4, 0.9);
+        let tl = Trimline::new(s.clone(), s0, 1, c);
+        let mut one = [Vec3::ZERO];
+        tl.derivatives_in(&[v, t], 0, &mut one);
+        let want = Vec3::new(2.0 * s0 * v.cos(), 2.0 * s0 * v.sin(), t) * c;
+        assert!((one[0] - want).norm() < 1e-15, "{} vs {want}", one[0]);
+        for order in 0..3 {
+            let tl = Trimline::new(s.clone(), s0, order, c);
+            for len in 1..5 {
+                for slot in 0..2 {
+                    let (mut fast, mut slow) = (vec![Vec3::ZERO; len], vec![Vec3::ZERO; len]);
+                    tl.derivatives_in(&[v, t], slot, &mut fast);
+                    derivatives_by_jet(&tl, &[v, t], slot, &mut slow);
+                    for (a, b) in fast.iter().zip(&slow) {
+                        // two exact evaluations in different operation orders
+                        assert!(
+                            (*a - *b).norm() <= 1e-14 * b.norm().max(1.0),
+                            "order {order}, slot {slot}: {a} vs {b}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
