@@ -138,10 +138,37 @@ fn surfaces(c: &mut Criterion) {
     g.finish();
 }
 
+/// The Rust side of the Python module's overhead figure (issue: ≤ 1.2 × through Python):
+/// 10⁶ exact points of the Bloor–Wilson blend through `sample::points_into`, the call
+/// `Patch.evaluate` makes (compare `crates/pdeshape-py/bench/evaluate.py`, same points).
+fn evaluate_million(c: &mut Criterion) {
+    let bw = load("bloor-wilson-blend.toml");
+    let p = &bw.patches[0];
+    let n = 1_000_000;
+    // the same low-discrepancy points as the Python script: u = frac(k φ₁), v = 2π frac(k φ₂)
+    let (g1, g2) = (0.7548776662466927, 0.5698402909980532);
+    let params: Vec<f64> = (0..n)
+        .flat_map(|k| {
+            let k = k as f64;
+            [(k * g1).fract(), 2.0 * std::f64::consts::PI * (k * g2).fract()]
+        })
+        .collect();
+    let mut g = c.benchmark_group("evaluate");
+    g.sample_size(10);
+    g.bench_function("bloor-wilson 10^6 points (sample::points_into)", |b| {
+        b.iter(|| {
+            let mut out = vec![0.0; 3 * n];
+            pdeshape_io::sample::points_into(pdeshape_io::sample::Target::of(p), &params, &mut out);
+            out
+        })
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     // no plots: criterion's plot backend needs system fonts
     config = Criterion::default().without_plots();
-    targets = surfaces
+    targets = surfaces, evaluate_million
 }
 criterion_main!(benches);
