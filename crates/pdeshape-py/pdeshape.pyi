@@ -1,0 +1,86 @@
+"""PDE-based shape design: exact PDE surfaces, blends and solids from numpy."""
+
+from os import PathLike
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class SceneError(Exception):
+    """A scene that cannot be loaded; ``str(e)`` is the CLI's message."""
+
+    file: str
+    line: Optional[int]
+    column: Optional[int]
+    key: str
+    message: str
+
+class Mesh:
+    """A triangle mesh as numpy arrays (trimesh, pyvista, libigl take them directly)."""
+
+    name: str
+    vertices: npt.NDArray[np.float64]  # (N, 3)
+    faces: npt.NDArray[np.uint32]  # (M, 3), counter-clockwise about the normal
+    normals: Optional[npt.NDArray[np.float64]]  # (N, 3), unit
+    uvs: Optional[npt.NDArray[np.float64]]  # (N, 2), parameters scaled to [0, 1]
+    fields: Dict[str, npt.NDArray[np.float64]]  # name -> (N,)
+
+class Patch:
+    """One solved patch of a scene."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def kind(self) -> str:
+        """'hermite', 'pde', 'blend', 'dynamic' or 'solid'."""
+    @property
+    def resolution(self) -> Tuple[int, int]: ...
+    @property
+    def v_domain(self) -> Tuple[float, float, bool]:
+        """(start, end, periodic)."""
+    @property
+    def times(self) -> Optional[Tuple[float, float]]:
+        """A dynamic blend's time range, else None."""
+    def evaluate(self, uv: npt.NDArray[np.float64], t: Optional[float] = None) -> npt.NDArray[np.float64]:
+        """Exact points (N, 3) at parameters (N, 2) — (N, 3) of (u, v, w) for a solid.
+
+        Equal bit for bit to ``pdeshape sample``. ``t`` selects a dynamic blend's frame.
+        """
+    def derivatives(
+        self, uv: npt.NDArray[np.float64], du: int = 1, dv: int = 1, t: Optional[float] = None
+    ) -> npt.NDArray[np.float64]:
+        """Exact partials (N, du+1, dv+1, 3); ``[k, i, j]`` is d^(i+j)X/du^i dv^j at uv[k]."""
+    def mesh(self, resolution: Optional[Tuple[int, int]] = None, t: Optional[float] = None) -> Mesh:
+        """The patch's mesh as the exporters write it."""
+
+class Scene:
+    """A loaded, solved scene (immutable: ``set`` returns a new one)."""
+
+    @staticmethod
+    def load(
+        path: Union[str, PathLike], *, solver: Optional[str] = None, terms: Optional[int] = None, **params: float
+    ) -> Scene: ...
+    @staticmethod
+    def from_toml(
+        text: str, name: str = "scene", *, solver: Optional[str] = None, terms: Optional[int] = None, **params: float
+    ) -> Scene: ...
+    def set(self, **values: float) -> Scene:
+        """A new scene with parameters changed, solved again."""
+    @property
+    def parameters(self) -> Dict[str, Dict[str, Any]]:
+        """name -> {value, min, max, step, expr, description}, in file order."""
+    @property
+    def patches(self) -> List[Patch]: ...
+    @property
+    def file(self) -> str: ...
+    @property
+    def title(self) -> Optional[str]: ...
+    def patch(self, name: str) -> Patch: ...
+    def __getitem__(self, name: str) -> Patch: ...
+    def __len__(self) -> int: ...
+    def check(self) -> Dict[str, Any]:
+        """The report ``pdeshape check --json`` prints."""
+    def export(self, path: Union[str, PathLike], format: Optional[str] = None) -> None:
+        """Writes every patch's mesh (obj, ply, stl, gltf, glb, vtu, ...) or a png picture."""

@@ -1,0 +1,217 @@
+"""The Python module against the CLI, closed forms and itself (run by .ci/run in a venv).
+
+The CLI binary is found at $PDESHAPE_BIN, else target/release/pdeshape or
+target/debug/pdeshape (built by `cargo test`); a missing binary fails the tests that need it.
+"""
+
+import json
+import math
+import os
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pdeshape
+
+ROOT = Path(__file__).resolve().parents[3]
+EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
+
+
+def cli():
+    env = os.environ.get("PDESHAPE_BIN")
+    candidates = [Path(env)] if env else [ROOT / "target/release/pdeshape", ROOT / "target/debug/pdeshape"]
+    for c in candidates:
+        if c.is_file():
+            return str(c)
+    pytest.fail(f"no pdeshape binary at {candidates}: run `cargo build` first or set PDESHAPE_BIN")
+
+
+def random_params(patch, n, seed):
+    """n random parameter rows inside the patch's domain."""
+    rng = np.random.default_rng(seed)
+    if patch.kind == "solid":
+        return rng.random((n, 3))
+    start, end, _ = patch.v_domain
+    return np.column_stack([rng.random(n), start + (end - start) * rng.random(n)])
+
+
+def test_examples_exist():
+    assert len(EXAMPLES) >= 20, EXAMPLES
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_every_example_loads_and_meshes(path):
+    scene = pdeshape.Scene.load(path)
+    assert len(scene) == len(scene.patches) > 0
+    for patch in scene.patches:
+        mesh = patch.mesh()
+        v, f = mesh.vertices, mesh.faces
+        assert v.dtype == np.float64 and v.ndim == 2 and v.shape[1] == 3 and v.shape[0] > 0
+        assert f.dtype == np.uint32 and f.ndim == 2 and f.shape[1] == 3 and f.shape[0] > 0
+        assert np.isfinite(v).all()
+        assert int(f.max()) < v.shape[0]
+        if mesh.normals is not None:
+            assert mesh.normals.shape == v.shape and mesh.normals.dtype == np.float64
+            # unit normals to round-off (normalised in f64)
+            assert np.abs(np.linalg.norm(mesh.normals, axis=1) - 1).max() < 1e-12
+        if mesh.uvs is not None:
+            assert mesh.uvs.shape == (v.shape[0], 2) and mesh.uvs.dtype == np.float64
+        for name, values in mesh.fields.items():
+            assert values.shape == (v.shape[0],), name
+
+
+@pytest.mark.parametrize(
+    "name, time",
+    [("klein-bottle", None), ("bloor-wilson-blend", None), ("dynamic-sine", 0.35), ("solid-cylinders", None),
+     ("trim-circle", None), ("blend-cone-cylinder", None)],
+)
+def test_evaluate_equals_the_cli_sample_bit_for_bit(name, time):
+    path = ROOT / "examples" / f"{name}.toml"
+    scene = pdeshape.Scene.load(path)
+    patch = scene.patches[0]
+    uv = random_params(patch, 200, seed=7)
+    got = patch.evaluate(uv, t=time)
+    assert got.shape == (200, 3) and got.dtype == np.float64
+    cmd = [cli(), "sample", str(path), "--patch", patch.name]
+    if time is not None:
+        cmd += ["--time", repr(time)]
+    text = "\n".join(",".join(repr(float(x)) for x in row) for row in uv)
+    out = subprocess.run(cmd, input=text, capture_output=True, text=True, check=True).stdout.splitlines()
+    want = np.array([[float(x) for x in line.split(",")[-3:]] for line in out[1:]])
+    # %.17e round-trips every f64: equality is bit for bit
+    assert want.shape == got.shape
+    assert np.array_equal(got, want), np.abs(got - want).max()
+
+
+def klein_section(s, v, alpha=6.0, beta=16.0):
+    """The analytic Klein-bottle section the example interpolates (its `expr`)."""
+    g = 4 * (1 - math.cos(s) / 2)
+    if math.pi - s > 0:
+        x = alpha * math.cos(s) * (1 + math.sin(s)) + g * math.cos(s) * math.cos(v)
+        y = beta * math.sin(s) + g * math.sin(s) * math.cos(v)
+    else:
+        x = alpha * math.cos(s) * (1 + math.sin(s)) + g * math.cos(v + math.pi)
+        y = beta * math.sin(s)
+    return np.array([x, y, g * math.sin(v)])
+
+
+def klein_section_dv(s, v):
+    """Its v-derivative, by hand."""
+    g = 4 * (1 - math.cos(s) / 2)
+    if math.pi - s > 0:
+        return np.array([-g * math.cos(s) * math.sin(v), -g * math.sin(s) * math.sin(v), g * math.cos(v)])
+    return np.array([-g * math.sin(v + math.pi), 0.0, g * math.cos(v)])
+
+
+def test_klein_slider_sweep_meets_the_analytic_sections():
+    base = pdeshape.Scene.load(ROOT / "examples/klein-bottle.toml")
+    a_range = base.parameters["a"]
+    assert (a_range["min"], a_range["max"]) == (0.3, 3.0)
+    v = np.linspace(0, 2 * math.pi, 37)
+    for a in np.linspace(a_range["min"], a_range["max"], 5):
+        patch = base.set(a=float(a)).patches[0]
+        for i in (0, 7, 20, 33, 39):
+            u = (1 - math.cos(math.pi * i / 39)) / 2  # Chebyshev-spaced section i
+            s = 2 * math.pi * i / 39
+            got = patch.evaluate(np.column_stack([np.full_like(v, u), v]))
+            want = np.array([klein_section(s, vv) for vv in v])
+            # the interpolation conditions hold to round-off of coordinates of size ~20
+            assert np.abs(got - want).max() <= 1e-10 * np.abs(want).max(), (a, i)
+            # and so do their exact v-derivatives (the sections' derivative by hand)
+            d = patch.derivatives(np.column_stack([np.full_like(v, u), v]), du=0, dv=1)
+            assert d.shape == (len(v), 1, 2, 3)
+            dv = np.array([klein_section_dv(s, vv) for vv in v])
+            assert np.abs(d[:, 0, 1, :] - dv).max() <= 1e-10 * np.abs(dv).max(), (a, i)
+            assert np.array_equal(d[:, 0, 0, :], got) or np.abs(d[:, 0, 0, :] - got).max() < 1e-12
+
+
+def test_set_returns_a_new_scene_and_leaves_the_old_one():
+    s1 = pdeshape.Scene.load(ROOT / "examples/klein-bottle.toml")
+    s2 = s1.set(a=2.0)
+    assert s1.parameters["a"]["value"] == 1.0 and s2.parameters["a"]["value"] == 2.0
+    uv = np.array([[0.3, 1.0]])
+    assert not np.array_equal(s1.patches[0].evaluate(uv), s2.patches[0].evaluate(uv))
+
+
+def test_check_is_the_cli_report():
+    path = ROOT / "examples/bloor-wilson-blend.toml"
+    got = pdeshape.Scene.load(path).check()
+    want = json.loads(subprocess.run([cli(), "check", "--json", str(path)], capture_output=True, text=True, check=True).stdout)
+    assert got == want
+
+
+def test_export_writes_what_build_writes(tmp_path):
+    path = ROOT / "examples/hermite-ruled.toml"
+    ours = tmp_path / "ours.ply"
+    pdeshape.Scene.load(path).export(ours)
+    theirs = tmp_path / "theirs.ply"
+    subprocess.run([cli(), "build", "-q", str(path), "-o", str(theirs)], check=True)
+    assert ours.read_bytes() == theirs.read_bytes()
+    with pytest.raises(ValueError, match="unknown format"):
+        pdeshape.Scene.load(path).export(tmp_path / "x.nope")
+    assert not (tmp_path / "x.nope").exists()
+
+
+def test_bad_scenes_raise_with_the_place():
+    text = '[patches.p]\nkind = "hermite"\nconditions = [\n  { u = 0, curve = "nope" },\n]\n'
+    with pytest.raises(pdeshape.SceneError) as e:
+        pdeshape.Scene.from_toml(text, "bad.toml")
+    err = e.value
+    assert err.file == "bad.toml"
+    assert err.line == 4 and isinstance(err.column, int) and err.column > 1, (err.line, err.column, str(err))
+    assert "nope" in str(err)
+    with pytest.raises(pdeshape.SceneError) as e:
+        pdeshape.Scene.load(ROOT / "examples/does-not-exist.toml")
+    assert "cannot read the scene file" in str(e.value) and e.value.line is None
+    with pytest.raises(pdeshape.SceneError, match="parameter"):
+        pdeshape.Scene.load(ROOT / "examples/klein-bottle.toml", nosuch=1.0)
+
+
+def test_bad_arguments_raise_value_errors():
+    patch = pdeshape.Scene.load(ROOT / "examples/bloor-wilson-blend.toml").patches[0]
+    with pytest.raises(ValueError, match="shape"):
+        patch.evaluate(np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="outside"):
+        patch.evaluate(np.array([[1.5, 0.0]]))
+    with pytest.raises(ValueError, match="not finite"):
+        patch.evaluate(np.array([[0.5, np.nan]]))
+    with pytest.raises(ValueError, match="takes no t"):
+        patch.evaluate(np.array([[0.5, 0.0]]), t=0.5)
+    with pytest.raises(ValueError, match="at most"):
+        patch.derivatives(np.array([[0.5, 0.0]]), du=3)
+    with pytest.raises(KeyError):
+        pdeshape.Scene.load(ROOT / "examples/bloor-wilson-blend.toml")["nope"]
+
+
+def test_non_contiguous_input_is_evaluated_like_contiguous():
+    patch = pdeshape.Scene.load(ROOT / "examples/four-curve-patch.toml").patches[0]
+    uv = random_params(patch, 50, seed=3)
+    wide = np.zeros((50, 4))
+    wide[:, 0], wide[:, 2] = uv[:, 0], uv[:, 1]
+    assert np.array_equal(patch.evaluate(wide[:, ::2]), patch.evaluate(uv))
+
+
+def test_threads_get_the_same_arrays():
+    patch = pdeshape.Scene.load(ROOT / "examples/klein-bottle.toml").patches[0]
+    uv = random_params(patch, 20000, seed=11)  # above the parallel threshold
+    want = patch.evaluate(uv)
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda _: patch.evaluate(uv), range(8)))
+    for r in results:
+        assert np.array_equal(r, want)
+
+
+def test_help_is_useful():
+    assert "Scene.load" in pdeshape.__doc__ and "evaluate" in pdeshape.__doc__
+    assert "bit for bit" in pdeshape.Patch.evaluate.__doc__
+
+
+def test_the_sweep_example_runs_and_plots(tmp_path):
+    import runpy
+
+    out = tmp_path / "sweep.png"
+    runpy.run_path(str(ROOT / "examples/python/sweep.py"), run_name="sweep")["main"](str(out))
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 10_000
