@@ -6,7 +6,7 @@ use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, continuity, 
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
 use pdeshape_core::num::MaxNan;
-use pdeshape_core::patch::{Condition, Surface};
+use pdeshape_core::patch::{Condition, CurvatureKind, Surface};
 use pdeshape_core::patch::{PrimarySurface, check_conditions};
 use serde_json::{Value, json};
 
@@ -77,24 +77,39 @@ fn dynamic_animation(
     Ok(anim)
 }
 
-/// The editor's mesh of a patch at time `t`: [`patch_mesh_at`] plus the exact mean
-/// curvature field (of the frame at `t` for a dynamic blend; none for solids).
+/// The editor's mesh of a patch at time `t`: [`patch_mesh_at`] plus every exact curvature
+/// field ([`analysis_mesh`] with all of [`CurvatureKind::ALL`]).
 pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
+    analysis_mesh(p, t, &CurvatureKind::ALL)
+}
+
+/// The mesh of a patch at time `t` with the exact curvature fields `kinds` (of the frame at
+/// `t` for a dynamic blend; none for solids, whose boundary is not one surface).
+pub fn analysis_mesh(p: &ScenePatch, t: Option<f64>, kinds: &[CurvatureKind]) -> Result<Mesh, String> {
     let m = match (&p.dynamic, t) {
         _ if p.solid.is_some() => unchecked_mesh(p)?,
         (Some(d), Some(t)) => {
             let (mut m, frame) = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
-            m.add_mean_curvature(&frame);
+            m.add_curvatures(&frame, kinds);
             m
         }
         _ => {
             let mut m = unchecked_mesh(p)?;
-            m.add_mean_curvature(p.surface.as_ref());
+            m.add_curvatures(p.surface.as_ref(), kinds);
             m
         }
     };
     m.check_finite()?;
     Ok(m)
+}
+
+/// The meshes a picture with the view of `r` needs: [`patch_mesh_at`], with the curvature
+/// field of a curvature view.
+fn view_mesh(p: &ScenePatch, t: Option<f64>, r: &RenderSettings) -> Result<Mesh, String> {
+    match r.view.curvature() {
+        Some(k) => analysis_mesh(p, t, &[k]),
+        None => patch_mesh_at(p, t),
+    }
 }
 
 /// The mesh of a patch at time `t` (dynamic blends; other patches ignore `t`).
@@ -278,6 +293,11 @@ pub fn context_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
 
 /// The context surfaces at time `t` (moving primary surfaces of dynamic blends).
 pub fn context_meshes_at(scene: &Scene, t: f64) -> Result<Vec<Mesh>, String> {
+    context_meshes_with(scene, t, &[])
+}
+
+/// The context surfaces at time `t` with the exact curvature fields `kinds`.
+pub fn context_meshes_with(scene: &Scene, t: f64, kinds: &[CurvatureKind]) -> Result<Vec<Mesh>, String> {
     let mut out = Vec::new();
     for s in &scene.surfaces {
         let Some(range) = s.s_range else { continue };
@@ -285,60 +305,100 @@ pub fn context_meshes_at(scene: &Scene, t: f64) -> Result<Vec<Mesh>, String> {
         let mut m = grid_mesh(&ps, &GridOptions::new(s.resolution.0, s.resolution.1))
             .map_err(|e| format!("surface `{}`: {e}", s.name))?;
         m.name = format!("surface-{}", s.name);
+        m.add_curvatures(&ps, kinds);
         m.check_finite()?;
         out.push(m);
     }
     Ok(out)
 }
 
-/// Renders patches (coloured) with the context surfaces (neutral).
+/// Renders patches (coloured) with the context surfaces (neutral), in the view of `r`:
+/// zebra stripes and isophotes on everything drawn; a curvature map (its field must be on
+/// the meshes: [`analysis_mesh`], [`context_meshes_with`]) on a diverging scale whose
+/// symmetric limit is `r.curvature_limit` or the 95th percentile of `|value|` over every
+/// mesh drawn, with a legend.
 pub fn render_meshes(patches: &[Mesh], context: &[Mesh], colors: &[Option<[f64; 3]>], r: &RenderSettings) -> Image {
+    use crate::render::{Paint, View};
+    let limit = r.view.curvature().map(|k| {
+        let limit = r.curvature_limit.unwrap_or_else(|| {
+            let values = patches.iter().chain(context).filter_map(|m| m.field(k.field_name()));
+            crate::render::abs_quantile(values.flat_map(|f| f.values.iter().copied()), 0.95)
+        });
+        // a flat map (all zero) still needs a positive scale
+        if limit > 0.0 { limit } else { 1.0 }
+    });
+    let paint = |field: Option<&String>| match r.view {
+        View::Shaded => field.map_or(Paint::Color, |f| Paint::Field(f.clone())),
+        View::Zebra => Paint::Zebra { stripes: r.stripes, angle: r.stripe_angle },
+        View::Isophotes => Paint::Isophotes { stripes: r.stripes },
+        View::Curvature(k) => Paint::Diverging { field: k.field_name().into(), limit: limit.unwrap_or(1.0) },
+    };
     let mut items = Vec::new();
     for m in context {
-        items.push(RenderItem { mesh: m, color: CONTEXT_COLOR, field: None, wireframe: false });
+        items.push(RenderItem { mesh: m, color: CONTEXT_COLOR, paint: paint(None), wireframe: false });
     }
     for (k, m) in patches.iter().enumerate() {
         let color = colors.get(k).copied().flatten().map(|c| c.map(|x| x as f32)).unwrap_or(PALETTE[k % PALETTE.len()]);
-        items.push(RenderItem { mesh: m, color, field: r.field.clone(), wireframe: r.wireframe });
+        items.push(RenderItem { mesh: m, color, paint: paint(r.field.as_ref()), wireframe: r.wireframe });
     }
     let cam = Camera { azimuth: r.azimuth, elevation: r.elevation, zoom: r.zoom, width: r.size.0, height: r.size.1 };
-    render(&items, &cam)
+    let mut img = render(&items, &cam);
+    if let (Some(k), Some(limit)) = (r.view.curvature(), limit) {
+        let title = match k {
+            CurvatureKind::Gauss => "Gaussian curvature K",
+            CurvatureKind::Mean => "mean curvature H",
+            CurvatureKind::K1 => "principal curvature k1 (min)",
+            CurvatureKind::K2 => "principal curvature k2 (max)",
+        };
+        crate::render::draw_legend(&mut img, title, limit);
+    }
+    img
 }
 
 /// Renders the whole scene. A scene of several blends between the same surfaces (an
 /// order study) becomes a strip with one panel per blend ([`blend_strip`]).
 pub fn render_scene(scene: &Scene) -> Result<Image, String> {
-    if let Some(strip) = blend_strip(scene) {
+    render_scene_with(scene, &scene.render)
+}
+
+/// [`render_scene`] with other render settings (e.g. another view).
+pub fn render_scene_with(scene: &Scene, r: &RenderSettings) -> Result<Image, String> {
+    if let Some(strip) = blend_strip_with(scene, r) {
         return strip;
     }
-    if let Some(strip) = dynamic_strip(scene) {
+    if let Some(strip) = dynamic_strip_with(scene, r) {
         return strip;
     }
-    let patches = patch_meshes(scene)?;
-    let mut context = context_meshes(scene)?;
+    let patches = scene.patches.iter().map(|p| view_mesh(p, None, r)).collect::<Result<Vec<_>, _>>()?;
+    let mut context = context_meshes_with(scene, 0.0, r.view.curvature().as_slice())?;
     for p in &scene.patches {
         context.extend(solid_context(p));
     }
     let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
-    Ok(render_meshes(&patches, &context, &colors, &scene.render))
+    Ok(render_meshes(&patches, &context, &colors, r))
 }
 
 /// For scenes whose patches are all blends (two or more): one panel per blend, drawn with
 /// the primary surfaces, and its continuity numbers printed under it.
 pub fn blend_strip(scene: &Scene) -> Option<Result<Image, String>> {
+    blend_strip_with(scene, &scene.render)
+}
+
+/// [`blend_strip`] with the render settings `r`.
+fn blend_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, String>> {
     if scene.patches.len() < 2 || scene.patches.iter().any(|p| p.blend.is_none()) {
         return None;
     }
     let run = || -> Result<Image, String> {
-        let context = context_meshes(scene)?;
+        let context = context_meshes_with(scene, 0.0, r0.view.curvature().as_slice())?;
         let n = scene.patches.len() as u32;
-        let mut r = scene.render.clone();
-        let w = (scene.render.size.0 * 2 / n.min(3)).clamp(64, 520);
+        let mut r = r0.clone();
+        let w = (r0.size.0 * 2 / n.min(3)).clamp(64, 520);
         r.size = (w, w * 5 / 4);
         let caption_h = 118;
         let mut panels = Vec::new();
         for (k, p) in scene.patches.iter().enumerate() {
-            let m = patch_mesh(p)?;
+            let m = view_mesh(p, None, &r)?;
             let img = render_meshes(std::slice::from_ref(&m), &context, &[p.color.or(Some(palette(k)))], &r);
             let mut panel = Image::new(img.width, img.height + caption_h, [255, 255, 255]);
             panel.paste(&img, 0, 0);
@@ -374,16 +434,21 @@ pub fn blend_strip(scene: &Scene) -> Option<Result<Image, String>> {
 /// For scenes with a dynamic blend: one panel per frame time (patches and moving primary
 /// surfaces at that time), captioned with the time.
 pub fn dynamic_strip(scene: &Scene) -> Option<Result<Image, String>> {
+    dynamic_strip_with(scene, &scene.render)
+}
+
+/// [`dynamic_strip`] with the render settings `r`.
+fn dynamic_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, String>> {
     let d = scene.patches.iter().find_map(|p| p.dynamic.as_ref())?;
     let run = || -> Result<Image, String> {
         let times = d.frame_times();
-        let mut r = scene.render.clone();
-        let w = (scene.render.size.0 * 3 / times.len().max(3) as u32).clamp(64, 400);
+        let mut r = r0.clone();
+        let w = (r0.size.0 * 3 / times.len().max(3) as u32).clamp(64, 400);
         r.size = (w, w * 4 / 3);
         let mut panels = Vec::new();
         for &t in &times {
-            let context = context_meshes_at(scene, t)?;
-            let meshes = scene.patches.iter().map(|p| patch_mesh_at(p, Some(t))).collect::<Result<Vec<_>, _>>()?;
+            let context = context_meshes_with(scene, t, r.view.curvature().as_slice())?;
+            let meshes = scene.patches.iter().map(|p| view_mesh(p, Some(t), &r)).collect::<Result<Vec<_>, _>>()?;
             let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
             let img = render_meshes(&meshes, &context, &colors, &r);
             panels.push(captioned(&img, &format!("t = {t:.2}"), 34, 22.0));

@@ -98,6 +98,20 @@ enum Command {
         /// Draw mesh lines.
         #[arg(long)]
         wireframe: bool,
+        /// What the surfaces show: shaded, zebra (reflection lines), isophotes, or a curvature
+        /// map: gauss, mean, k1 (smaller principal), k2 (larger principal).
+        #[arg(long, default_value = "shaded", value_parser = view)]
+        view: pdeshape_io::render::View,
+        /// Zebra and isophote stripes, black and white each over a half turn (1 to 200).
+        #[arg(long, value_parser = stripes)]
+        stripes: Option<f64>,
+        /// Zebra stripe direction in the image plane, degrees from horizontal (finite).
+        #[arg(long, allow_hyphen_values = true, value_parser = finite)]
+        stripe_angle: Option<f64>,
+        /// Symmetric limit of a curvature map's colour scale (positive, finite); default:
+        /// the 95th percentile of |value| over everything drawn.
+        #[arg(long, value_parser = positive)]
+        curvature_limit: Option<f64>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -157,6 +171,23 @@ fn finite(s: &str) -> Result<f64, String> {
 fn elevation(s: &str) -> Result<f64, String> {
     let x = finite(s)?;
     if (-90.0..=90.0).contains(&x) { Ok(x) } else { Err(format!("{x} is outside [-90, 90] degrees")) }
+}
+
+/// A surface view of `render --view`.
+fn view(s: &str) -> Result<pdeshape_io::render::View, String> {
+    s.parse()
+}
+
+/// A stripe count: 1 to 200.
+fn stripes(s: &str) -> Result<f64, String> {
+    let x = finite(s)?;
+    if (1.0..=200.0).contains(&x) { Ok(x) } else { Err(format!("{x} is outside [1, 200]")) }
+}
+
+/// A positive finite number.
+fn positive(s: &str) -> Result<f64, String> {
+    let x = finite(s)?;
+    if x > 0.0 { Ok(x) } else { Err(format!("{x} is not positive")) }
 }
 
 /// A time limit in seconds: positive, at most a day.
@@ -466,7 +497,20 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 _ => sample(p.surface.as_ref()),
             }
         }
-        Command::Render { scene, out, width, height, azimuth, elevation, wireframe, set } => {
+        Command::Render {
+            scene,
+            out,
+            width,
+            height,
+            azimuth,
+            elevation,
+            wireframe,
+            view,
+            stripes,
+            stripe_angle,
+            curvature_limit,
+            set,
+        } => {
             let mut sc = loader(&set, None, None).scene(&scene)?;
             if let Some(w) = width {
                 sc.render.size.0 = w;
@@ -481,6 +525,10 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 sc.render.elevation = e;
             }
             sc.render.wireframe |= wireframe;
+            sc.render.view = view;
+            sc.render.stripes = stripes.unwrap_or(sc.render.stripes);
+            sc.render.stripe_angle = stripe_angle.unwrap_or(sc.render.stripe_angle);
+            sc.render.curvature_limit = curvature_limit.or(sc.render.curvature_limit);
             let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
             write_png(&out, &img)?;
             if !quiet {

@@ -65,6 +65,21 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
             return e;
         }
     }
+    // blends beside their zebra picture: the stripes show the seams' continuity (a jump at
+    // C0, a kink at G1/C1, smooth at G2/C2) on the blends and their primary surfaces
+    if scene.patches.iter().any(|p| p.blend.is_some() || p.dynamic.is_some()) {
+        let zebra =
+            pdeshape_io::scene::RenderSettings { view: pdeshape_io::render::View::Zebra, ..scene.render.clone() };
+        match model::render_scene_with(&scene, &zebra) {
+            Ok(img) => {
+                let rel = format!("{name}/{name}-zebra.png");
+                if pdeshape_io::export::write_atomic(&dir.join(&rel), |w| img.write_png(w)).is_ok() {
+                    e.plots.push(rel);
+                }
+            }
+            Err(err) => e.error = Some(err),
+        }
+    }
     for (i, st) in scene.studies.iter().enumerate() {
         match model::study_strip(&scene, st) {
             Ok(img) => {

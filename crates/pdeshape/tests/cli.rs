@@ -176,3 +176,53 @@ fn bench_prints_the_papers_tables() {
     assert_eq!(d["paper_002_accuracy"].as_array().unwrap().len(), 48);
     assert!(out.with_extension("md").exists() && out.with_extension("json").exists());
 }
+
+/// `render --view`: every view draws a different picture than the shaded one (and than each
+/// other); unknown views and bad stripe counts are usage errors that write nothing.
+#[test]
+fn render_views() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut pictures = Vec::new();
+    for view in ["shaded", "zebra", "isophotes", "gauss", "mean", "k1", "k2"] {
+        let out = dir.path().join(format!("{view}.png"));
+        Command::cargo_bin("pdeshape")
+            .unwrap()
+            .args(["render", "--width", "160", "--height", "120", "--view", view, "-o"])
+            .arg(&out)
+            .arg(example("bloor-wilson-blend.toml"))
+            .assert()
+            .success();
+        pictures.push((view, std::fs::read(&out).unwrap()));
+    }
+    for (i, (a, pa)) in pictures.iter().enumerate() {
+        for (b, pb) in &pictures[i + 1..] {
+            assert_ne!(pa, pb, "{a} and {b} draw the same picture");
+        }
+    }
+    for bad in [
+        &["--view", "stripes"][..],
+        &["--view", "zebra", "--stripes", "0"],
+        &["--view", "mean", "--curvature-limit", "-1"],
+    ] {
+        let out = dir.path().join("bad.png");
+        let o = Command::cargo_bin("pdeshape")
+            .unwrap()
+            .arg("render")
+            .args(bad)
+            .arg("-o")
+            .arg(&out)
+            .arg(example("bloor-wilson-blend.toml"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(!out.exists(), "{bad:?} wrote a file");
+    }
+    let o = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["render", "--view", "stripes", "-o", "x.png"])
+        .arg(example("bloor-wilson-blend.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("unknown view `stripes` (one of: shaded, zebra, isophotes, gauss, mean, k1, k2)"), "{err}");
+}

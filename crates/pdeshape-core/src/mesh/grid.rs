@@ -2,7 +2,7 @@
 
 use super::{Mesh, ScalarField};
 use crate::Vec3;
-use crate::patch::Surface;
+use crate::patch::{CurvatureKind, Surface};
 use rayon::prelude::*;
 
 /// Options for [`grid_mesh`].
@@ -31,6 +31,18 @@ pub fn grid_params(s: &dyn Surface, o: &GridOptions) -> (Vec<f64>, Vec<f64>) {
     (us, vs)
 }
 
+/// The reference size of `|X_u||X_v|` for degeneracy tests (poles): the median over at
+/// most 4097 evenly strided points of `(X_u, X_v)`.
+fn area_scale<I: ExactSizeIterator<Item = (Vec3, Vec3)>>(d: I) -> f64 {
+    let stride = (d.len() / 4096).max(1);
+    let mut scales: Vec<f64> = d.step_by(stride).map(|(xu, xv)| xu.norm() * xv.norm()).collect();
+    if scales.is_empty() {
+        return f64::MIN_POSITIVE;
+    }
+    let mid = scales.len() / 2;
+    scales.select_nth_unstable_by(mid, f64::total_cmp).1.max(f64::MIN_POSITIVE)
+}
+
 /// Meshes a patch on a structured `nu × nv` grid.
 ///
 /// Normals are analytic: `n = X_u × X_v / |X_u × X_v|`. Where the cross product vanishes
@@ -47,10 +59,7 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     let n = o.nu * o.nv;
     // reference size of |X_u||X_v| for the degeneracy test: the median over at most
     // 4097 evenly strided vertices
-    let stride = (n / 4096).max(1);
-    let mut scales: Vec<f64> = flat.iter().step_by(stride).map(|d| d[1].norm() * d[2].norm()).collect();
-    let mid = scales.len() / 2;
-    let reference = scales.select_nth_unstable_by(mid, f64::total_cmp).1.max(f64::MIN_POSITIVE);
+    let reference = area_scale(flat.iter().map(|d| (d[1], d[2])));
     if let Some(k) = flat.par_iter().position_first(|d| !d[0].is_finite()) {
         return Err(format!("the patch is not finite at (u, v) = ({}, {})", us[k / o.nv], vs[k % o.nv]));
     }
@@ -110,11 +119,15 @@ pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
 }
 
 impl Mesh {
-    /// Adds the exact mean curvature ([`crate::patch::mean_curvature`]) of `s` at every
-    /// vertex as the field `mean_curvature`: on the grid path (`Surface::grid2`) for a
-    /// structured grid mesh over `u ∈ [0, 1]`, else at each vertex's `(u, v)` from its UV
-    /// (`u = uv₀`, `v` the domain at `uv₁`). 0 where it is undefined (poles).
-    pub fn add_mean_curvature(&mut self, s: &dyn Surface) {
+    /// Adds the exact curvatures ([`crate::patch::curvature`]) of `s` at every vertex, one
+    /// field per kind ([`CurvatureKind::field_name`]): on the grid path (`Surface::grid2`)
+    /// for a structured grid mesh over `u ∈ [0, 1]`, else at each vertex's `(u, v)` from its
+    /// UV (`u = uv₀`, `v` the domain at `uv₁`). 0 where they are undefined: at poles, where
+    /// `|X_u × X_v|` is below 1e-8 of the median `|X_u||X_v|`.
+    pub fn add_curvatures(&mut self, s: &dyn Surface, kinds: &[CurvatureKind]) {
+        if kinds.is_empty() {
+            return;
+        }
         let jets = match self.grid {
             Some((nu, nv)) if nu * nv == self.positions.len() => {
                 let (us, vs) = grid_params(s, &GridOptions::new(nu, nv));
@@ -125,8 +138,24 @@ impl Mesh {
                 self.uvs.par_iter().map(|uv| s.jet2(uv[0], dom.at(uv[1]))).collect()
             }
         };
-        let values = jets.par_iter().map(|j| crate::patch::mean_curvature(j).unwrap_or(0.0)).collect();
-        self.fields.push(ScalarField { name: "mean_curvature".into(), values });
+        // a pole (|X_u × X_v| below 1e-8 of the patch's typical |X_u||X_v|) has no
+        // curvature: at a distance δ from it the formulas lose ~ε/δ relatively (N and G
+        // are O(δ) and O(δ²) from O(1) data), so the cut keeps ~1e-8 relative accuracy
+        let reference = area_scale(jets.iter().map(|j| (j[1], j[2])));
+        let curv: Vec<Option<crate::patch::Curvature>> = jets
+            .par_iter()
+            .map(|j| if j[1].cross(j[2]).norm() > 1e-8 * reference { crate::patch::curvature(j) } else { None })
+            .collect();
+        for &k in kinds {
+            let values = curv.iter().map(|c| c.as_ref().map_or(0.0, |c| k.of(c))).collect();
+            self.fields.push(ScalarField { name: k.field_name().into(), values });
+        }
+    }
+
+    /// Adds the exact mean curvature as the field `mean_curvature`
+    /// ([`add_curvatures`](Self::add_curvatures) of [`CurvatureKind::Mean`]).
+    pub fn add_mean_curvature(&mut self, s: &dyn Surface) {
+        self.add_curvatures(s, &[CurvatureKind::Mean]);
     }
 
     /// Adds a per-vertex field computed from `(u, v)` of a structured grid mesh.
@@ -176,6 +205,29 @@ mod tests {
             match crate::patch::mean_curvature(j) {
                 Some(h) => assert!((h.abs() - 1.0).abs() < 1e-12, "u = {u}: H = {h}"),
                 None => assert_eq!(u, 0.0, "H undefined away from the pole"),
+            }
+        }
+    }
+
+    #[test]
+    fn curvature_fields_of_the_unit_sphere() {
+        let mut m = grid_mesh(&Sphere, &GridOptions::new(11, 9)).unwrap();
+        m.add_curvatures(&Sphere, &CurvatureKind::ALL);
+        let f = |k: CurvatureKind| &m.field(k.field_name()).unwrap().values;
+        for (i, uv) in m.uvs.iter().enumerate() {
+            let pole = uv[0] == 0.0 || uv[0] == 1.0;
+            let (g, h, k1, k2) = (
+                f(CurvatureKind::Gauss)[i],
+                f(CurvatureKind::Mean)[i],
+                f(CurvatureKind::K1)[i],
+                f(CurvatureKind::K2)[i],
+            );
+            if pole {
+                assert_eq!((g, h, k1, k2), (0.0, 0.0, 0.0, 0.0), "undefined at the poles: 0");
+            } else {
+                // K = 1 and |H| = 1 to round-off; κ₁, κ₂ to √ε (an umbilic: see curvature.rs)
+                assert!((g - 1.0).abs() < 1e-13 && (h.abs() - 1.0).abs() < 1e-13, "{uv:?}: {g} {h}");
+                assert!((k1 - h).abs() < 1e-6 && (k2 - h).abs() < 1e-6 && k1 <= k2, "{uv:?}: {k1} {k2}");
             }
         }
     }

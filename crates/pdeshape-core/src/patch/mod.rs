@@ -4,9 +4,11 @@
 //! meshing (normals), condition checks and continuity diagnostics work the same way for
 //! all of them. Conditions ([`Condition`]) prescribe `∂ᵈX/∂uᵈ (uᵢ, v) = gᵢ(v)`.
 
+mod curvature;
 mod hermite;
 mod primary;
 
+pub use curvature::{Curvature, CurvatureKind, curvature};
 pub use hermite::{HermiteBasis, HermitePatch, HermitePatchError, Poly, cubic_hermite};
 pub use primary::PrimarySurface;
 
@@ -120,16 +122,7 @@ pub trait Surface: Send + Sync {
 /// assert!((mean_curvature(&j).unwrap() - 0.5).abs() < 1e-15);
 /// ```
 pub fn mean_curvature(j: &[Vec3; 6]) -> Option<f64> {
-    let [_, xu, xv, xuu, xuv, xvv] = *j;
-    let n = xu.cross(xv);
-    let area2 = n.dot(n);
-    let (e, f, g) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
-    if !(area2 > 1e-24 * e * g && area2.is_finite()) {
-        return None;
-    }
-    let n = n * (1.0 / area2.sqrt());
-    let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
-    Some((e * nn - 2.0 * f * m + g * l) / (2.0 * area2))
+    curvature(j).map(|c| c.mean)
 }
 
 /// Result of checking a patch against its conditions.

@@ -1,15 +1,18 @@
-//! Headless pictures (SPEC §8): a software rasterizer for shaded meshes (no GPU), text
-//! captions, image strips, and 2D plots.
+//! Headless pictures (SPEC §8): a software rasterizer for shaded meshes (no GPU) with
+//! surface-quality views (zebra, isophotes, curvature maps), text captions, image strips,
+//! and 2D plots.
 
 mod image;
 mod plot;
 mod raster;
 mod text;
+mod view;
 
 pub use image::Image;
 pub use plot::{Layer, Series, line_plot, polyline_plot};
-pub use raster::{Camera, RenderItem, render};
+pub use raster::{Camera, Paint, RenderItem, render};
 pub use text::draw_text;
+pub use view::{View, abs_quantile, diverging, draw_legend};
 
 /// Colours for patches, cycled.
 pub const PALETTE: [[f32; 3]; 8] = [

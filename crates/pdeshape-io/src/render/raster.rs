@@ -1,6 +1,6 @@
 //! A z-buffer software rasterizer with smooth shading, wireframe and highlighted curves.
 
-use super::{Image, colormap};
+use super::{Image, colormap, diverging};
 use pdeshape_core::Vec3;
 use pdeshape_core::mesh::Mesh;
 
@@ -11,10 +11,39 @@ pub struct RenderItem<'a> {
     pub mesh: &'a Mesh,
     /// Base colour (linear 0…1).
     pub color: [f32; 3],
-    /// Colour by this field instead (min…max mapped through the colour map).
-    pub field: Option<String>,
+    /// How the surface is painted.
+    pub paint: Paint,
     /// Draw the mesh edges.
     pub wireframe: bool,
+}
+
+/// How a surface is painted (the zebra and isophote models are documented at [`super::View`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Paint {
+    /// The item's colour, shaded.
+    Color,
+    /// A per-vertex field, its min…max through the sequential colour map, shaded.
+    Field(String),
+    /// A per-vertex field on the diverging scale `[−limit, limit]` (0 neutral), shaded.
+    Diverging {
+        /// The field.
+        field: String,
+        /// The symmetric limit (> 0).
+        limit: f64,
+    },
+    /// Reflection lines: `stripes` black and `stripes` white tubes around the view,
+    /// along the screen direction at `angle` degrees from horizontal.
+    Zebra {
+        /// Number of black (and of white) stripes over a half turn.
+        stripes: f64,
+        /// Stripe direction in the screen plane, degrees.
+        angle: f64,
+    },
+    /// Bands of equal illumination, `2 · stripes` over the half turn of `n·l`.
+    Isophotes {
+        /// Number of dark (and of light) bands.
+        stripes: f64,
+    },
 }
 
 /// An orthographic camera looking at the centre of the scene.
@@ -108,16 +137,28 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
     for it in items {
         let m = it.mesh;
         let proj: Vec<(f64, f64, f64)> = m.positions.iter().map(|p| view.project(*p)).collect();
-        let field = it.field.as_ref().and_then(|n| m.field(n)).map(|f| {
-            let (a, b) = f.values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
-            (f, a, if b > a { b - a } else { 1.0 })
-        });
+        let field = match &it.paint {
+            Paint::Field(n) => m.field(n).map(|f| {
+                let (a, b) =
+                    f.values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+                (&f.values, a, if b > a { b - a } else { 1.0 }, false)
+            }),
+            Paint::Diverging { field, limit } => m.field(field).map(|f| (&f.values, 0.0, *limit, true)),
+            _ => None,
+        };
         let vcol: Vec<[f32; 3]> = (0..m.positions.len())
             .map(|i| match &field {
-                Some((f, a, r)) => colormap((f.values[i] - a) / r),
+                Some((f, _, l, true)) => diverging(f[i] / l),
+                Some((f, a, r, false)) => colormap((f[i] - a) / r),
                 None => it.color,
             })
             .collect();
+        let (ang_c, ang_s) = match it.paint {
+            Paint::Zebra { angle, .. } => (angle.to_radians().cos(), angle.to_radians().sin()),
+            _ => (1.0, 0.0),
+        };
+        let axis = right * ang_c + up * ang_s;
+        let across = toward.cross(axis);
         for t in m.all_triangles() {
             let [a, b, c] = t.map(|i| i as usize);
             raster_triangle(&view, &mut color, &mut depth, [proj[a], proj[b], proj[c]], |l0, l1, l2| {
@@ -132,7 +173,22 @@ pub fn render(items: &[RenderItem], cam: &Camera) -> Image {
                 }
                 let base: [f32; 3] =
                     std::array::from_fn(|k| vcol[a][k] * l0 as f32 + vcol[b][k] * l1 as f32 + vcol[c][k] * l2 as f32);
-                shade(base, n, light, fill, toward)
+                match it.paint {
+                    Paint::Zebra { stripes, .. } => {
+                        // the view ray d = −toward reflected about n
+                        let r = -toward + n * (2.0 * n.dot(toward));
+                        let phi = r.dot(across).atan2(r.dot(toward));
+                        let band = (phi / std::f64::consts::PI * stripes).floor() as i64;
+                        if band.rem_euclid(2) == 0 { [0.07, 0.07, 0.09] } else { [0.96, 0.96, 0.96] }
+                    }
+                    Paint::Isophotes { stripes } => {
+                        let angle = n.dot(light).clamp(-1.0, 1.0).acos();
+                        let band = (angle / std::f64::consts::PI * 2.0 * stripes).floor() as i64;
+                        let s = shade(base, n, light, fill, toward);
+                        if band.rem_euclid(2) == 0 { s } else { s.map(|x| x * 0.55) }
+                    }
+                    _ => shade(base, n, light, fill, toward),
+                }
             });
         }
         if it.wireframe {
@@ -273,4 +329,69 @@ fn downsample(c: &[[f32; 3]], w: usize, _h: usize, ow: u32, oh: u32) -> Image {
         }
     }
     img
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square in the y–z plane (facing the camera at azimuth 0, elevation 0: the view
+    /// direction is −x, right = +y, up = +z) whose normals are all `n`.
+    fn square(n: Vec3) -> Mesh {
+        let positions = vec![
+            Vec3::new(0.0, -1.0, -1.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(0.0, -1.0, 1.0),
+        ];
+        Mesh { positions, normals: vec![n; 4], quads: vec![[0, 1, 2, 3]], ..Default::default() }
+    }
+
+    fn centre(m: &Mesh, paint: Paint) -> [u8; 3] {
+        let cam = Camera { azimuth: 0.0, elevation: 0.0, zoom: 1.0, width: 32, height: 32 };
+        let img = render(&[RenderItem { mesh: m, color: [0.5, 0.5, 0.5], paint, wireframe: false }], &cam);
+        let i = (16 * 32 + 16) * 4;
+        [img.data[i], img.data[i + 1], img.data[i + 2]]
+    }
+
+    /// The zebra model (see `View`): a normal tilted by β about the stripes' axis turns the
+    /// reflected ray by 2β, so the pixel shows tube ⌊2β · n/π⌋ (even black, odd white); a
+    /// tilt about the perpendicular axis leaves the tube unchanged.
+    #[test]
+    fn zebra_stripes_follow_the_reflected_angle() {
+        let (black, white) = ([18, 18, 23], [245, 245, 245]);
+        let zebra = |angle: f64| Paint::Zebra { stripes: 8.0, angle };
+        for (beta, want) in [(0.0f64, black), (0.1, black), (0.25, white), (0.45, black), (0.6, white)] {
+            // horizontal tubes (axis = right = +y): tilt the normal up, about +y
+            let n = Vec3::new(beta.cos(), 0.0, beta.sin());
+            let band = (2.0 * beta / std::f64::consts::PI * 8.0).floor();
+            assert_eq!(band as i64 % 2 == 0, want == black, "the table above is the formula");
+            assert_eq!(centre(&square(n), zebra(0.0)), want, "β = {beta}");
+            // the same tilt about the vertical axis does not change the tube of horizontal
+            // stripes, but it does for vertical ones (angle 90°)
+            let n = Vec3::new(beta.cos(), beta.sin(), 0.0);
+            assert_eq!(centre(&square(n), zebra(0.0)), black, "β = {beta} about z");
+            // (for vertical tubes, axis = up, the angle is measured towards w × up = −right)
+            let n = Vec3::new(beta.cos(), -beta.sin(), 0.0);
+            assert_eq!(centre(&square(n), zebra(90.0)), want, "β = {beta} about z, vertical stripes");
+        }
+    }
+
+    #[test]
+    fn diverging_paint_maps_the_field_symmetrically() {
+        let mut m = square(Vec3::new(1.0, 0.0, 0.0));
+        m.fields.push(crate::render::raster::tests::field("k", [2.0; 4]));
+        let red = centre(&m, Paint::Diverging { field: "k".into(), limit: 2.0 });
+        m.fields[0].values = vec![-2.0; 4];
+        let blue = centre(&m, Paint::Diverging { field: "k".into(), limit: 2.0 });
+        m.fields[0].values = vec![0.0; 4];
+        let grey = centre(&m, Paint::Diverging { field: "k".into(), limit: 2.0 });
+        assert!(red[0] > red[2] + 60, "{red:?}");
+        assert!(blue[2] > blue[0] + 60, "{blue:?}");
+        assert!(grey[0].abs_diff(grey[2]) < 4 && grey[0] > 150, "{grey:?}");
+    }
+
+    fn field(name: &str, v: [f64; 4]) -> pdeshape_core::mesh::ScalarField {
+        pdeshape_core::mesh::ScalarField { name: name.into(), values: v.to_vec() }
+    }
 }

@@ -343,11 +343,31 @@ pub struct RenderSettings {
     pub field: Option<String>,
     /// Zoom factor.
     pub zoom: f64,
+    /// What the surfaces show: shading, zebra, isophotes or a curvature map.
+    pub view: crate::render::View,
+    /// Zebra and isophote stripes (black and white each, over a half turn).
+    pub stripes: f64,
+    /// Zebra stripe direction in the screen plane (degrees from horizontal).
+    pub stripe_angle: f64,
+    /// Symmetric limit of a curvature map's colour scale; `None`: the 95th percentile of
+    /// `|value|` over everything drawn.
+    pub curvature_limit: Option<f64>,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { azimuth: 35.0, elevation: 25.0, size: (800, 600), wireframe: false, field: None, zoom: 1.0 }
+        RenderSettings {
+            azimuth: 35.0,
+            elevation: 25.0,
+            size: (800, 600),
+            wireframe: false,
+            field: None,
+            zoom: 1.0,
+            view: crate::render::View::Shaded,
+            stripes: 8.0,
+            stripe_angle: 0.0,
+            curvature_limit: None,
+        }
     }
 }
 
