@@ -2,7 +2,7 @@
 
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
-use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, continuity, gaps_at};
+use pdeshape_core::blend::{DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, gaps_at, seam_gaps};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
 use pdeshape_core::num::MaxNan;
@@ -942,6 +942,38 @@ fn gaps_json(g: &Gaps) -> Value {
     o
 }
 
+/// Per measure, the worst place over both trimlines: `{value, end, u, v, point}` (the
+/// larger end wins; NaN wins over numbers; the start wins ties).
+fn worst_json(b: &dyn Surface, seams: &[SeamGaps]) -> Value {
+    type Pick = fn(&Gaps) -> Option<f64>;
+    let picks: [(&str, Pick); 5] =
+        [("c0", |g| g.c0), ("c1", |g| g.c1), ("g1_radians", |g| g.g1), ("c2", |g| g.c2), ("g2", |g| g.g2)];
+    let mut o = json!({});
+    for (key, pick) in picks {
+        let mut best: Option<(f64, usize, f64)> = None;
+        for (e, sg) in seams.iter().enumerate() {
+            if let (Some(x), Some(v)) = (pick(&sg.max), pick(&sg.at)) {
+                let better = match best {
+                    None => true,
+                    Some((b, ..)) => !b.is_nan() && (x.is_nan() || x > b),
+                };
+                if better {
+                    best = Some((x, e, v));
+                }
+            }
+        }
+        if let Some((x, e, v)) = best {
+            let u = e as f64;
+            let q = b.point(u, v);
+            let end = ["start", "end"][e];
+            let mut w = json!({"end": end, "u": u, "v": v, "point": [q.x, q.y, q.z]});
+            put(&mut w, "value", Some(x));
+            o[key] = w;
+        }
+    }
+    o
+}
+
 fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut Value, size: f64) {
     let b = setup.blend.as_ref();
     let comps: Vec<Value> = b
@@ -990,13 +1022,14 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
             Some(worst)
         })
         .flatten();
-    let ends: Vec<Gaps> = [0.0, 1.0]
+    let seams: Vec<SeamGaps> = [0.0, 1.0]
         .iter()
         .map(|&u| {
             let e = end_data(p, u);
-            continuity(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], 400)
+            seam_gaps(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], 400)
         })
         .collect();
+    let ends: Vec<Gaps> = seams.iter().map(|s| s.max).collect();
     d["blend"] = json!({ "components": comps });
     put(&mut d["blend"], "exact_vs_collocation_max_distance", distance);
     d["continuity"] = json!({
@@ -1004,6 +1037,7 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
         "end": gaps_json(&ends[1]),
         "class": continuity_class(&ends, size),
         "samples": 400,
+        "worst": worst_json(b, &seams),
     });
     for (r, axis) in b.reports().iter().zip(["x", "y", "z"]) {
         if !r.elliptic

@@ -271,7 +271,8 @@ impl Load<'_> {
     }
 }
 
-/// The continuity line of a blend's diagnostics: the gaps at both trimlines and the class.
+/// The continuity line of a blend's diagnostics: the gaps at both trimlines, the class and
+/// where the G1 angle is worst.
 pub fn continuity_line(p: &serde_json::Value) -> Option<String> {
     let c = &p["continuity"];
     if !c.is_object() {
@@ -288,12 +289,17 @@ pub fn continuity_line(p: &serde_json::Value) -> Option<String> {
             f(&e["g2"])
         )
     };
-    Some(format!(
+    let mut line = format!(
         "continuity {}: u=0 [{}]  u=1 [{}]",
         c["class"].as_str().unwrap_or("?"),
         end(&c["start"]),
         end(&c["end"])
-    ))
+    );
+    let w = &c["worst"]["g1_radians"];
+    if let (Some(u), Some(v)) = (w["u"].as_f64(), w["v"].as_f64()) {
+        line.push_str(&format!("; worst G1 angle {} rad at (u, v) = ({u}, {v:.4})", f(&w["value"])));
+    }
+    Some(line)
 }
 
 fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {

@@ -36,6 +36,20 @@ fn continuity_table_of_the_cone_cylinder_blends() {
             let c2 = d["continuity"][end]["c2"].as_f64().unwrap();
             assert_eq!(c2 <= 1e-8, class == "C2", "{name}: C2 gap {c2}");
         }
+        // the worst place of each measure: its value is the larger end's maximum, and its
+        // point is the patch at its (u, v), on its trimline
+        for key in ["c0", "c1", "g1_radians", "c2", "g2"] {
+            let w = &d["continuity"]["worst"][key];
+            let c = &d["continuity"];
+            let (a, b) = (c["start"][key].as_f64().unwrap(), c["end"][key].as_f64().unwrap());
+            assert_eq!(w["value"].as_f64(), Some(if b > a { b } else { a }), "{name} {key}: {w}");
+            assert_eq!(w["end"], if b > a { "end" } else { "start" });
+            let (u, v) = (w["u"].as_f64().unwrap(), w["v"].as_f64().unwrap());
+            assert_eq!(u, if b > a { 1.0 } else { 0.0 });
+            let q = p.surface.point(u, v);
+            let pt: Vec<f64> = w["point"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            assert_eq!(pt, vec![q.x, q.y, q.z], "{name} {key}");
+        }
     }
 }
 

@@ -87,10 +87,46 @@ pub fn gaps_at(x: &dyn Surface, u_e: f64, v: f64, data: [Option<&FieldRef>; 3]) 
 
 /// The largest gaps over `samples` points of the trimline `u = u_e`.
 pub fn continuity(x: &dyn Surface, u_e: f64, data: [Option<&FieldRef>; 3], samples: usize) -> Gaps {
+    seam_gaps(x, u_e, data, samples).max
+}
+
+/// The largest gaps along a trimline and where they are.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SeamGaps {
+    /// Entry-wise maximum over the samples (NaN when any sample is NaN).
+    pub max: Gaps,
+    /// Per entry, the `v` of its maximum (the first NaN sample when there is one; the first
+    /// of equal maxima otherwise).
+    pub at: Gaps,
+}
+
+/// The gaps at `samples` points `v = start + (i + ½)/samples · (end − start)` of the
+/// trimline `u = u_e`, their maxima and where the maxima are.
+pub fn seam_gaps(x: &dyn Surface, u_e: f64, data: [Option<&FieldRef>; 3], samples: usize) -> SeamGaps {
     let dom = x.v_domain();
-    (0..samples)
-        .map(|i| gaps_at(x, u_e, dom.at((i as f64 + 0.5) / samples as f64), data))
-        .fold(Gaps::default(), Gaps::max)
+    let mut out = SeamGaps::default();
+    for i in 0..samples {
+        let v = dom.at((i as f64 + 0.5) / samples as f64);
+        let g = gaps_at(x, u_e, v, data);
+        let take = |best: &mut Option<f64>, at: &mut Option<f64>, new: Option<f64>| {
+            if let Some(y) = new {
+                let replace = match *best {
+                    None => true,
+                    Some(b) => !b.is_nan() && (y.is_nan() || y > b),
+                };
+                if replace {
+                    *best = Some(y);
+                    *at = Some(v);
+                }
+            }
+        };
+        take(&mut out.max.c0, &mut out.at.c0, g.c0);
+        take(&mut out.max.c1, &mut out.at.c1, g.c1);
+        take(&mut out.max.g1, &mut out.at.g1, g.g1);
+        take(&mut out.max.c2, &mut out.at.c2, g.c2);
+        take(&mut out.max.g2, &mut out.at.g2, g.g2);
+    }
+    out
 }
 
 #[cfg(test)]
@@ -133,5 +169,39 @@ mod tests {
         let d = Param(f).derivatives(1.0, 0.4, 2, 2);
         let k = cross_curvature(d[3], d[1], d[6], d[4], d[2]).unwrap();
         assert!((k.abs() - 1.0 / 3.0).abs() < 1e-13, "{k}");
+    }
+
+    /// Against a sphere whose radius is 3 + 0.1 (1 + cos(v − 1.3)), the position gap along
+    /// the trimline is 0.1 (1 + cos(v − 1.3)) (same direction, different radius): largest,
+    /// 0.2, at v = 1.3, which the samples find to within half their spacing.
+    #[test]
+    fn seam_gaps_find_the_worst_place() {
+        let e = ["3*sin(s)*cos(v)", "3*sin(s)*sin(v)", "3*cos(s)"];
+        let f = ExprField::parse(e, &["s", "v", "t"], &|_| None).unwrap();
+        let r = "(3 + 0.1*(1 + cos(v - 1.3)))";
+        let o = [format!("{r}*sin(s)*cos(v)"), format!("{r}*sin(s)*sin(v)"), format!("{r}*cos(s)")];
+        let other: FieldRef =
+            Arc::new(ExprField::parse(o.each_ref().map(|x| x.as_str()), &["s", "v", "t"], &|_| None).unwrap());
+        let data: Vec<FieldRef> =
+            (0..3).map(|k| Arc::new(Trimline::new(other.clone(), 1.0, k, 1.0)) as FieldRef).collect();
+        let n = 400;
+        let g = seam_gaps(&Param(f), 1.0, [Some(&data[0]), Some(&data[1]), Some(&data[2])], n);
+        let (v, c0) = (g.at.c0.unwrap(), g.max.c0.unwrap());
+        let half = std::f64::consts::PI / n as f64;
+        assert!((v - 1.3).abs() <= half, "{v}");
+        // 0.1 (1 + cos δ) with |δ| ≤ half a spacing
+        assert!(c0 <= 0.2 && c0 >= 0.1 * (1.0 + half.cos()) - 1e-15, "{c0}");
+        assert_eq!(
+            g.max,
+            continuity(
+                &Param(ExprField::parse(e, &["s", "v", "t"], &|_| None).unwrap()),
+                1.0,
+                [Some(&data[0]), Some(&data[1]), Some(&data[2])],
+                n
+            )
+        );
+        for at in [g.at.c1, g.at.g1, g.at.c2, g.at.g2] {
+            assert!(at.is_some_and(|v| (0.0..2.0 * std::f64::consts::PI).contains(&v)));
+        }
     }
 }
