@@ -153,15 +153,18 @@ fn add_continuity_fields(m: &mut Mesh, p: &ScenePatch, s: &dyn pdeshape_core::pa
     use rayon::prelude::*;
     let dom = s.v_domain();
     let ends = [end_data(p, 0.0), end_data(p, 1.0)];
-    let gaps: Vec<Gaps> = m
-        .uvs
-        .par_iter()
-        .map(|uv| {
-            let e = usize::from(uv[0] >= 0.5);
-            let d = &ends[e];
-            gaps_at(s, e as f64, dom.at(uv[1]), [d[0].as_ref(), d[1].as_ref(), d[2].as_ref()])
-        })
-        .collect();
+    let at = |e: usize, f: f64| {
+        let d = &ends[e];
+        gaps_at(s, e as f64, dom.at(f), [d[0].as_ref(), d[1].as_ref(), d[2].as_ref()])
+    };
+    let gaps: Vec<Gaps> = match m.grid {
+        // a grid's column shares its v: the gaps of the 2 nv seam points, spread over the rows
+        Some((nu, nv)) if nu * nv == m.uvs.len() => {
+            let seams: Vec<Gaps> = (0..2 * nv).into_par_iter().map(|k| at(k / nv, m.uvs[k % nv][1])).collect();
+            (0..nu * nv).map(|k| seams[usize::from(m.uvs[k][0] >= 0.5) * nv + k % nv]).collect()
+        }
+        _ => m.uvs.par_iter().map(|uv| at(usize::from(uv[0] >= 0.5), uv[1])).collect(),
+    };
     type Pick = fn(&Gaps) -> Option<f64>;
     let picks: [(&str, Pick); 5] = [
         ("c0_gap", |g| g.c0),

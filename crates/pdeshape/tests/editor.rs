@@ -60,8 +60,9 @@ fn pos(v: &Value) -> (f64, f64) {
     (v[0].as_f64().unwrap().round(), v[1].as_f64().unwrap().round())
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
+/// Starts chromedriver and a headless Chromium (software WebGL); `None` when no driver is
+/// installed and `PDESHAPE_REQUIRE_BROWSER` is not 1 (the test is then skipped).
+async fn browser() -> Option<(Client, Kill)> {
     let required = std::env::var("PDESHAPE_REQUIRE_BROWSER").is_ok_and(|v| v == "1");
     let driver_bin = ["/usr/bin/chromedriver", "/usr/lib/chromium/chromedriver"]
         .into_iter()
@@ -69,11 +70,10 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
     let Some(driver_bin) = driver_bin else {
         assert!(!required, "chromedriver not found: install Debian's chromium and chromium-driver");
         eprintln!("skipped: no chromedriver (install chromium and chromium-driver; .ci/run does)");
-        return;
+        return None;
     };
-    let (_server, url) = serve(Some("trim-spline.toml"));
     let port = free_port();
-    let _driver = Kill(
+    let driver = Kill(
         Command::new(driver_bin)
             .arg(format!("--port={port}"))
             .stdout(Stdio::null())
@@ -97,6 +97,13 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
             }
         }
     };
+    Some((c, driver))
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
+    let Some((c, _driver)) = browser().await else { return };
+    let (_server, url) = serve(Some("trim-spline.toml"));
     c.goto(&url).await.unwrap();
 
     // the first frame, with its diagnostics
@@ -153,5 +160,111 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
     assert!(d.as_str().unwrap().contains("o sheet"), "{d}");
     let bytes = js(&c, "return window.pdeshape.lastDownload.bytes").await;
     assert!(bytes.as_u64().unwrap() > 10_000, "{bytes}");
+    c.close().await.unwrap();
+}
+
+/// The analysis views on the cone–cylinder blends: each view changes the picture, curvature
+/// legends show finite numbers, the seams' worst-place markers are `check --json`'s, and
+/// "show" flies the camera there. Prints how many model updates per second the page
+/// received while a slider was moved continuously in the zebra view (a figure, not a
+/// pass/fail timing).
+#[tokio::test(flavor = "multi_thread")]
+async fn the_editor_shows_zebra_curvature_and_seam_continuity_in_chromium() {
+    let Some((c, _driver)) = browser().await else { return };
+    let (_server, url) = serve(Some("blend-cone-cylinder.toml"));
+    c.goto(&url).await.unwrap();
+    wait_for(&c, "the first frame", "return window.pdeshape.frames > 0 && window.pdeshape.vertexCount > 0").await;
+    wait_for(
+        &c,
+        "diagnostics and seam markers",
+        "return window.pdeshape.seamMarkers && window.pdeshape.seamMarkers.length === 6",
+    )
+    .await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let mut shots = vec![("shading".to_string(), c.screenshot().await.unwrap())];
+    for view in ["zebra", "isophotes", "gaussian_curvature", "mean_curvature", "k1", "k2"] {
+        let frames = js(&c, "return window.pdeshape.frames").await.as_u64().unwrap();
+        js(&c, &format!("const f = document.getElementById('field'); f.value = '{view}'; f.dispatchEvent(new Event('change')); return 0")).await;
+        wait_for(&c, view, &format!("return window.pdeshape.frames > {frames} && window.pdeshape.view === '{view}'"))
+            .await;
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        let shot = c.screenshot().await.unwrap();
+        for (other, s) in &shots {
+            assert_ne!(&shot, s, "{view} looks like {other}");
+        }
+        let legend = js(&c, "return window.pdeshape.legend").await;
+        let shown = js(&c, "return [...document.querySelectorAll('#legendnums span')].map((e) => e.textContent)").await;
+        if view.contains("curvature") || view.starts_with('k') {
+            let (lo, hi) = (legend["lo"].as_f64().unwrap(), legend["hi"].as_f64().unwrap());
+            assert!(hi.is_finite() && hi > 0.0 && lo == -hi, "{view}: {legend}");
+            let nums: Vec<f64> =
+                shown.as_array().unwrap().iter().map(|x| x.as_str().unwrap().parse().unwrap()).collect();
+            assert!(nums.iter().all(|x| x.is_finite()) && nums[1] == 0.0 && nums[2] > 0.0, "{view}: {shown}");
+        } else {
+            assert!(legend.is_null(), "{view}: no legend for stripes ({legend})");
+        }
+        shots.push((view.to_string(), shot));
+    }
+    // an edited limit is kept (and the automatic one switched off)
+    js(
+        &c,
+        "const e = document.getElementById('climit'); e.value = '0.5'; e.dispatchEvent(new Event('input')); return 0",
+    )
+    .await;
+    wait_for(&c, "the edited limit", "return window.pdeshape.legend && window.pdeshape.legend.hi === 0.5").await;
+
+    // the seam markers are check's worst places, value and point
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .args(["check", "--json"])
+        .arg(common::example("blend-cone-cylinder.toml"))
+        .output()
+        .unwrap();
+    let check: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let markers = js(&c, "return window.pdeshape.seamMarkers").await;
+    let markers = markers.as_array().unwrap();
+    for (m, p) in markers.iter().zip(check["patches"].as_array().unwrap()) {
+        let w = &p["continuity"]["worst"]["g1_radians"];
+        assert_eq!(m["patch"], p["name"]);
+        let nums = |x: &Value| -> Vec<f64> {
+            let mut v = vec![x["value"].as_f64().unwrap(), x["u"].as_f64().unwrap(), x["v"].as_f64().unwrap()];
+            v.extend(x["point"].as_array().unwrap().iter().map(|c| c.as_f64().unwrap()));
+            v
+        };
+        // the same f64 bits: the page shows the numbers check prints
+        assert_eq!(nums(m), nums(w), "{m} vs {w}");
+    }
+    let seams = js(&c, "return window.pdeshape.seams").await;
+    assert_eq!(seams.as_array().unwrap().len(), 12, "two seams per blend: {seams}");
+    // the C0 blend's seam is red where the C2 blend's is green (f32 of the per-vertex G1 angles)
+    assert!(seams[0]["max"].as_f64().unwrap() > 0.1 && seams[10]["max"].as_f64().unwrap() < 1e-9, "{seams}");
+    // "show" flies the camera to the worst place of o2
+    c.find(Locator::Css("button[data-seam='0']")).await.unwrap().click().await.unwrap();
+    wait_for(&c, "the flight", "return window.pdeshape.flying === false").await;
+    let target = js(&c, "return window.pdeshape.cam.target").await;
+    for k in 0..3 {
+        let (a, b) = (target[k].as_f64().unwrap(), markers[0]["point"][k].as_f64().unwrap());
+        assert!((a - b).abs() < 1e-12, "camera target {target} vs marker {}", markers[0]["point"]);
+    }
+
+    // live: a slider moved continuously for 3 s in the zebra view
+    js(
+        &c,
+        "const f = document.getElementById('field'); f.value = 'zebra'; f.dispatchEvent(new Event('change')); return 0",
+    )
+    .await;
+    let u0 = js(&c, "return window.pdeshape.updates").await.as_u64().unwrap();
+    let t0 = Instant::now();
+    js(&c, "const s = document.querySelector('input[type=range][data-param=R]'); let k = 0;
+            window.__sweep = setInterval(() => { s.value = 1.0 + 0.4 * Math.sin(k++ / 10); s.dispatchEvent(new Event('input')); }, 16);
+            return 0").await;
+    tokio::time::sleep(Duration::from_secs(3)).await;
+    js(&c, "clearInterval(window.__sweep); return 0").await;
+    let dt = t0.elapsed().as_secs_f64();
+    let n = js(&c, "return window.pdeshape.updates").await.as_u64().unwrap() - u0;
+    eprintln!(
+        "live updates while dragging R in the zebra view (blend-cone-cylinder, 6 blends): {n} in {dt:.1} s = {:.1}/s",
+        n as f64 / dt
+    );
+    assert!(n >= 3, "the view followed the slider {n} times in {dt:.1} s");
     c.close().await.unwrap();
 }

@@ -453,4 +453,34 @@ impl Surface for StaticBlend {
             })
             .collect()
     }
+
+    fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
+        // as `grid`, with second derivatives: the same sums in the same order as
+        // `derivatives(u, v, 2, 2)`, so the values are the pointwise ones bit for bit
+        let cols: Vec<[Vec<Vec<f64>>; 3]> = vs
+            .par_iter()
+            .map(|&v| std::array::from_fn(|t| self.comps[t].basis.iter().map(|g| g.derivatives(v, 2)).collect()))
+            .collect();
+        const IJ: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
+        us.par_iter()
+            .flat_map_iter(|&u| {
+                crate::cancel::checkpoint();
+                let row: [Vec<Vec<f64>>; 3] =
+                    std::array::from_fn(|t| self.comps[t].profiles.iter().map(|p| p.eval(u, 2)).collect());
+                cols.iter()
+                    .map(|col| {
+                        let mut o = [Vec3::ZERO; 6];
+                        for t in 0..3 {
+                            for (uu, gg) in row[t].iter().zip(&col[t]) {
+                                for (k, &(i, j)) in IJ.iter().enumerate() {
+                                    o[k][t] += uu[i] * gg[j];
+                                }
+                            }
+                        }
+                        o
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
 }

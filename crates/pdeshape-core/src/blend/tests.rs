@@ -118,6 +118,26 @@ fn continuity_follows_the_order() {
     assert!(mixed.g1.unwrap() > 1e-3, "a 2+2+6 blend is no better than C0: {mixed:?}");
 }
 
+/// The grid paths (`grid`, `grid2`) give the pointwise derivatives bit for bit, for the
+/// exact and the collocation solvers.
+#[test]
+fn grid_paths_equal_pointwise_derivatives() {
+    let conds = cone_cylinder();
+    let us = [0.0, 0.13, 0.5, 0.77, 1.0];
+    let vs = [0.0, 0.4, 2.1, 3.3, 6.0];
+    for solver in [Solver::Exact, Solver::Collocation] {
+        let o = BlendOptions { solver, bubbles: 4, ..Default::default() };
+        let b = StaticBlend::new(ops([2, 2, 3]), &conds, VDomain::PERIODIC, &o).unwrap();
+        let (g1, g2) = (b.grid(&us, &vs), b.grid2(&us, &vs));
+        for (k, (a1, a2)) in g1.iter().zip(&g2).enumerate() {
+            let (u, v) = (us[k / vs.len()], vs[k % vs.len()]);
+            assert_eq!(*a2, b.jet2(u, v), "{solver:?} grid2 at ({u}, {v})");
+            let d = b.derivatives(u, v, 1, 1);
+            assert_eq!(*a1, [d[0], d[2], d[1], d[3]], "{solver:?} grid at ({u}, {v})");
+        }
+    }
+}
+
 #[test]
 fn collocation_converges_to_the_exact_solution() {
     let conds = cone_cylinder();

@@ -1,4 +1,5 @@
-// pdeshape editor: WebGL2 view, parameter sliders, handles, trim editor, diagnostics.
+// pdeshape editor: WebGL2 view (shading, zebra, isophotes, curvature maps, seams), parameter
+// sliders, handles, trim editor, diagnostics.
 // State exposed for tests as window.pdeshape.
 "use strict";
 const S = window.pdeshape = {
@@ -73,25 +74,49 @@ function program(vs, fs) {
   if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
   return p;
 }
+// Surface views (the same models as `pdeshape render --view`, see render/view.rs): mode 0 the
+// patch colour, 1 a field min…max (sequential), 2 a field on the diverging scale ±range.y,
+// 3 zebra: the view ray reflected about the interpolated exact normal picks one of
+// `stripes` black and white light tubes along `axis` (screen plane): band ⌊φ·n/π⌋,
+// φ = atan2(r·(w × a), r·w); 4 isophotes: bands of acos(n·l), l the head light.
 const surf = program(`#version 300 es
 layout(location=0) in vec3 pos; layout(location=1) in vec3 nor; layout(location=2) in float fld;
 uniform mat4 view, proj; out vec3 vn; out vec3 vp; out float vf;
 void main() { vn = mat3(view) * nor; vec4 q = view * vec4(pos, 1.0); vp = q.xyz; vf = fld; gl_Position = proj * q; }`,
 `#version 300 es
-precision highp float; in vec3 vn; in vec3 vp; in float vf; uniform vec3 color; uniform int useField;
-uniform vec2 range; out vec4 o;
+precision highp float; in vec3 vn; in vec3 vp; in float vf; uniform vec3 color; uniform int mode;
+uniform vec2 range; uniform float stripes; uniform vec2 axis; out vec4 o;
+const float PI = 3.14159265358979;
 vec3 cmap(float t) { t = clamp(t, 0.0, 1.0);
   return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0); }
+vec3 diverging(float x) {
+  vec3 c[5] = vec3[5](vec3(0.230, 0.299, 0.754), vec3(0.552, 0.690, 0.996), vec3(0.865, 0.865, 0.865),
+                      vec3(0.958, 0.604, 0.482), vec3(0.706, 0.016, 0.150));
+  float t = (clamp(x, -1.0, 1.0) + 1.0) * 2.0; int i = min(int(floor(t)), 3);
+  return mix(c[i], c[i + 1], t - float(i)); }
 void main() {
   vec3 n = normalize(vn); vec3 v = normalize(-vp); if (dot(n, v) < 0.0) n = -n;
-  vec3 base = useField == 1 ? cmap((vf - range.x) / max(range.y - range.x, 1e-30)) : color;
+  if (mode == 3) {
+    vec3 r = reflect(-v, n); vec3 w = vec3(0.0, 0.0, 1.0); vec3 a = vec3(axis, 0.0);
+    float band = floor(atan(dot(r, cross(w, a)), dot(r, w)) / PI * stripes);
+    o = vec4(mod(band, 2.0) < 0.5 ? vec3(0.07, 0.07, 0.09) : vec3(0.96), 1.0); return;
+  }
+  vec3 base = mode == 1 ? cmap((vf - range.x) / max(range.y - range.x, 1e-30))
+            : mode == 2 ? diverging(vf / max(range.y, 1e-300)) : color;
   float d = max(dot(n, v), 0.0); float s = pow(max(dot(reflect(-v, n), v), 0.0), 40.0);
-  o = vec4(base * (0.25 + 0.75 * d) + vec3(0.25 * s), 1.0); }`);
+  vec3 c = base * (0.25 + 0.75 * d) + vec3(0.25 * s);
+  if (mode == 4 && mod(floor(acos(clamp(dot(n, v), -1.0, 1.0)) / PI * 2.0 * stripes), 2.0) > 0.5) c *= 0.55;
+  o = vec4(c, 1.0); }`);
 const flat = program(`#version 300 es
 layout(location=0) in vec3 pos; uniform mat4 view, proj; uniform float size;
 void main() { gl_Position = proj * view * vec4(pos, 1.0); gl_Position.z -= 0.0005 * gl_Position.w; gl_PointSize = size; }`,
 `#version 300 es
 precision highp float; uniform vec4 color; out vec4 o; void main() { o = color; }`);
+const seamProg = program(`#version 300 es
+layout(location=0) in vec3 pos; layout(location=1) in vec3 col; uniform mat4 view, proj; uniform float size; out vec3 vc;
+void main() { gl_Position = proj * view * vec4(pos, 1.0); gl_Position.z -= 0.001 * gl_Position.w; gl_PointSize = size; vc = col; }`,
+`#version 300 es
+precision highp float; in vec3 vc; out vec4 o; void main() { o = vec4(vc, 1.0); }`);
 
 function upload(header, bytes) {
   const f32 = (r) => new Float32Array(bytes, r.offset, r.count);
@@ -147,22 +172,26 @@ function draw() {
   gl.enable(gl.DEPTH_TEST);
   if (!model) return;
   const { view, proj } = matrices(w, h);
-  const field = $("field").value;
+  const field = $("field").value, scale = colourScale();
   gl.useProgram(surf);
   gl.uniformMatrix4fv(gl.getUniformLocation(surf, "view"), false, view);
   gl.uniformMatrix4fv(gl.getUniformLocation(surf, "proj"), false, proj);
+  const ang = parseFloat($("stripeangle").value) * Math.PI / 180;
+  gl.uniform1f(gl.getUniformLocation(surf, "stripes"), parseFloat($("stripes").value));
+  gl.uniform2f(gl.getUniformLocation(surf, "axis"), Math.cos(ang), Math.sin(ang));
   model.patches.forEach((p, i) => {
     const c = p.meta.color || PALETTE[i % PALETTE.length];
     gl.uniform3fv(gl.getUniformLocation(surf, "color"), c);
-    const fv = field && p.fields[field];
-    gl.uniform1i(gl.getUniformLocation(surf, "useField"), fv ? 1 : 0);
+    const fv = scale && p.fields[field];
+    const mode = field === "zebra" ? 3 : field === "isophotes" ? 4 : !fv ? 0 : scale.diverging ? 2 : 1;
+    gl.uniform1i(gl.getUniformLocation(surf, "mode"), mode);
     if (fv) {
-      let lo = Infinity, hi = -Infinity; for (const x of fv) { lo = Math.min(lo, x); hi = Math.max(hi, x); }
-      gl.uniform2f(gl.getUniformLocation(surf, "range"), lo, hi);
+      gl.uniform2f(gl.getUniformLocation(surf, "range"), scale.lo, scale.hi);
       gl.bindBuffer(gl.ARRAY_BUFFER, p.fieldBuf); gl.bufferData(gl.ARRAY_BUFFER, fv, gl.DYNAMIC_DRAW);
     }
     gl.bindVertexArray(p.vao); gl.drawElements(gl.TRIANGLES, p.n, gl.UNSIGNED_INT, 0);
   });
+  drawSeams(view, proj);
   gl.useProgram(flat);
   gl.uniformMatrix4fv(gl.getUniformLocation(flat, "view"), false, view);
   gl.uniformMatrix4fv(gl.getUniformLocation(flat, "proj"), false, proj);
@@ -180,9 +209,169 @@ function draw() {
   }
   gl.bindVertexArray(null);
   S.frames++;
+  S.view = field || "shading";
 }
 let drawQueued = false;
 function redraw() { if (!drawQueued) { drawQueued = true; requestAnimationFrame(() => { drawQueued = false; draw(); }); } }
+
+// ---------------- analysis: colour scales, legend, seams ----------------
+const CURVATURES = { gaussian_curvature: "Gaussian curvature K", mean_curvature: "mean curvature H",
+  k1: "principal curvature k1 (min)", k2: "principal curvature k2 (max)" };
+const VIEW_LABELS = { zebra: "zebra (reflection lines)", isophotes: "isophotes", ...CURVATURES };
+// the q-quantile of |x| over the finite values of some arrays (NaN when there are none)
+function absQuantile(arrays, q) {
+  const a = [];
+  for (const xs of arrays) for (const x of xs) if (Number.isFinite(x)) a.push(Math.abs(x));
+  if (!a.length) return NaN;
+  a.sort((x, y) => x - y);
+  return a[Math.round((a.length - 1) * q)];
+}
+// The colour scale of the chosen field: curvatures on a diverging scale ±L (L the 95th
+// percentile of |value| over every patch, or the user's), other fields min…max.
+let scaleCache = null;
+function colourScale() {
+  const field = $("field").value;
+  if (!model || !field || field === "zebra" || field === "isophotes") return null;
+  const arrays = model.patches.map((p) => p.fields[field]).filter((x) => x);
+  if (!arrays.length) return null;
+  const key = `${field}|${S.meshHash}|${$("cauto").checked}|${$("climit").value}`;
+  if (scaleCache && scaleCache.key === key) return scaleCache.scale;
+  let scale;
+  if (CURVATURES[field]) {
+    let L = parseFloat($("climit").value);
+    if ($("cauto").checked || !(L > 0)) {
+      L = absQuantile(arrays, 0.95);
+      if (!(L > 0)) L = 1;
+      $("climit").value = Number(L.toPrecision(4));
+    }
+    scale = { diverging: true, lo: -L, hi: L };
+  } else {
+    let lo = Infinity, hi = -Infinity;
+    for (const xs of arrays) for (const x of xs) if (Number.isFinite(x)) { lo = Math.min(lo, x); hi = Math.max(hi, x); }
+    scale = { diverging: false, lo, hi };
+  }
+  scaleCache = { key, scale };
+  return scale;
+}
+function fmt(x) { return Number.isFinite(x) ? (x === 0 ? "0" : x.toExponential(3)) : String(x); }
+function updateLegend() {
+  const field = $("field").value, scale = colourScale(), lg = $("legend");
+  $("stripebox").style.display = field === "zebra" || field === "isophotes" ? "block" : "none";
+  $("scalebox").style.display = CURVATURES[field] ? "block" : "none";
+  $("stripesval").textContent = $("stripes").value; $("angleval").textContent = `${$("stripeangle").value}°`;
+  if (!scale) { lg.style.display = "none"; S.legend = null; return; }
+  lg.style.display = "block";
+  $("legendtitle").textContent = CURVATURES[field] || field;
+  const stops = scale.diverging
+    ? ["#3b4cc0", "#8db0fe", "#dddddd", "#f49a7b", "#b40426"]
+    : ["#000080", "#0000ff", "#00ffff", "#ffff00", "#ff0000", "#800000"];
+  $("legendbar").style.background = `linear-gradient(to right, ${stops.join(", ")})`;
+  const mid = scale.diverging ? 0 : (scale.lo + scale.hi) / 2;
+  $("legendlo").textContent = fmt(scale.lo); $("legendmid").textContent = fmt(mid); $("legendhi").textContent = fmt(scale.hi);
+  S.legend = { title: $("legendtitle").textContent, lo: scale.lo, mid, hi: scale.hi };
+}
+// Seams: the first and last rows (u = 0 and u = 1) of a blend's grid, coloured by a
+// continuity field (green at round-off, 1e-12, through yellow to red at 1e-1 and above,
+// on a log scale); the worst place per patch from check's diagnostics, marked and listed.
+const SEAM_KEYS = { g1_angle: ["g1_radians", "G1 angle", " rad"], c0_gap: ["c0", "C0 gap", ""],
+  c1_gap: ["c1", "C1 gap", ""], c2_gap: ["c2", "C2 gap", ""], g2_gap: ["g2", "G2 gap", ""] };
+function seamColour(x) {
+  const t = Math.min(1, Math.max(0, (Math.log10(Math.max(x, 1e-300)) + 12) / 11));
+  return t < 0.5 ? [2 * t, 0.75, 0.1] : [1, 0.75 * (2 - 2 * t), 0.1];
+}
+let seamVaos = [], markerVao = null, markerCount = 0;
+function buildSeams() {
+  for (const s of seamVaos) gl.deleteVertexArray(s.vao);
+  seamVaos = [];
+  const key = $("seam").value;
+  S.seams = [];
+  if (!model || !key) { buildMarkers(); return; }
+  for (const p of model.patches) {
+    const f = p.fields[key], g = p.meta.grid;
+    if (!f || !g) continue;
+    const [nu, nv] = g;
+    for (const i of [0, nu - 1]) {
+      const pos = new Float32Array(nv * 3), col = new Float32Array(nv * 3);
+      let worst = -Infinity;
+      for (let j = 0; j < nv; j++) {
+        const k = i * nv + j;
+        pos.set(p.pos.subarray(3 * k, 3 * k + 3), 3 * j);
+        col.set(seamColour(f[k]), 3 * j);
+        worst = Math.max(worst, f[k]);
+      }
+      const vao = gl.createVertexArray(); gl.bindVertexArray(vao);
+      for (const [data, loc] of [[pos, 0], [col, 1]]) {
+        const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b); gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+        gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
+      }
+      gl.bindVertexArray(null);
+      seamVaos.push({ vao, n: nv });
+      S.seams.push({ patch: p.meta.name, u: i === 0 ? 0 : 1, field: key, max: worst });
+    }
+  }
+  buildMarkers();
+}
+function buildMarkers() {
+  const key = $("seam").value, box = $("seams");
+  box.innerHTML = ""; S.seamMarkers = [];
+  const d = S.diagnostics;
+  if (model && key && d && d.patches) {
+    const [dk, label, unit] = SEAM_KEYS[key];
+    for (const p of d.patches) {
+      const w = p.continuity && p.continuity.worst && p.continuity.worst[dk];
+      if (!w) continue;
+      const m = { patch: p.name, measure: dk, value: w.value, u: w.u, v: w.v, point: w.point };
+      S.seamMarkers.push(m);
+      const row = document.createElement("div");
+      row.innerHTML = `<button data-seam="${S.seamMarkers.length - 1}">show</button> ${p.name}: worst ${label} ${fmt(w.value)}${unit} at u = ${w.u}, v = ${w.v.toFixed(4)}`;
+      row.querySelector("button").onclick = () => flyTo(m.point);
+      box.appendChild(row);
+    }
+  }
+  $("seambox").style.display = S.seamMarkers.length || seamVaos.length ? "block" : "none";
+  const data = new Float32Array(S.seamMarkers.flatMap((m) => m.point));
+  const col = new Float32Array(S.seamMarkers.flatMap(() => [0.85, 0.1, 0.85]));
+  if (!markerVao) markerVao = gl.createVertexArray();
+  gl.bindVertexArray(markerVao);
+  for (const [arr, loc] of [[data, 0], [col, 1]]) {
+    const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b); gl.bufferData(gl.ARRAY_BUFFER, arr, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
+  }
+  gl.bindVertexArray(null); markerCount = S.seamMarkers.length;
+}
+function drawSeams(view, proj) {
+  if (!seamVaos.length && !markerCount) return;
+  gl.useProgram(seamProg);
+  gl.uniformMatrix4fv(gl.getUniformLocation(seamProg, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(seamProg, "proj"), false, proj);
+  gl.uniform1f(gl.getUniformLocation(seamProg, "size"), 4 * devicePixelRatio);
+  for (const s of seamVaos) {
+    gl.bindVertexArray(s.vao); gl.drawArrays(gl.LINE_STRIP, 0, s.n); gl.drawArrays(gl.POINTS, 0, s.n);
+  }
+  if (markerCount) {
+    gl.disable(gl.DEPTH_TEST);
+    gl.uniform1f(gl.getUniformLocation(seamProg, "size"), 13 * devicePixelRatio);
+    gl.bindVertexArray(markerVao); gl.drawArrays(gl.POINTS, 0, markerCount);
+    gl.enable(gl.DEPTH_TEST);
+  }
+}
+// moves the camera's target to `p` and closes in, over ~0.4 s
+function flyTo(p) {
+  const b = bounds(model.patches);
+  const dist = 0.45 * Math.hypot(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]);
+  const from = { target: cam.target.slice(), dist: cam.dist }, t0 = performance.now();
+  S.flying = true;
+  const step = () => {
+    const f = Math.min(1, (performance.now() - t0) / 400), e = f * f * (3 - 2 * f);
+    cam.target = from.target.map((x, k) => x + (p[k] - x) * e);
+    cam.dist = from.dist + (dist - from.dist) * e;
+    draw();
+    if (f < 1) requestAnimationFrame(step); else S.flying = false;
+  };
+  requestAnimationFrame(step);
+}
+S.cam = cam;
+S.flyTo = flyTo;
 
 // ---------------- server ----------------
 let edits = [];            // edits not yet folded into scene.text
@@ -212,10 +401,13 @@ async function solve(diagnostics) {
       model = { header, patches: upload(header, data) };
       S.header = header; S.meshHash = header.hash;
       S.vertexCount = header.patches.reduce((a, p) => a + p.vertices, 0);
-      if (header.diagnostics) { S.diagnostics = header.diagnostics; $("diag").textContent = summary(header.diagnostics); }
+      // the diagnostics (and the seam markers from them) belong to the model they came with
+      S.diagnostics = header.diagnostics || null;
+      if (header.diagnostics) $("diag").textContent = summary(header.diagnostics);
       showError(null);
       if (first) { fit(); buildPanel(header); }
-      syncPanel(header); uploadHandles(); drawTrim(); redraw();
+      syncPanel(header); uploadHandles(); drawTrim(); buildSeams(); updateLegend(); redraw();
+      S.updates = (S.updates || 0) + 1;
       $("status").textContent = `${header.title || header.name}: ${S.vertexCount} vertices, solved in ${header.solve_ms.toFixed(1)} ms, hash ${header.hash}`;
     }
   } catch (e) { showError(String(e)); }
@@ -265,7 +457,9 @@ function buildPanel(h) {
   }));
   const fs = $("field"); fs.innerHTML = `<option value="">shading</option>`;
   const names = new Set(h.patches.flatMap((p) => p.fields.map((f) => f.name)));
-  for (const n of names) fs.innerHTML += `<option>${n}</option>`;
+  const order = ["zebra", "isophotes", ...Object.keys(CURVATURES).filter((n) => names.has(n)),
+    ...[...names].filter((n) => !CURVATURES[n])];
+  for (const n of order) fs.innerHTML += `<option value="${n}">${VIEW_LABELS[n] || n}</option>`;
   if (h.time_range) {
     $("timebox").style.display = "block";
     const t = $("time"); t.min = h.time_range[0]; t.max = h.time_range[1]; t.step = (h.time_range[1] - h.time_range[0]) / 200;
@@ -295,7 +489,12 @@ async function download(format) {
   S.lastDownloadText = format === "obj" ? (await b.text()).slice(0, 200) : null;
   save(b, `${scene.name}.${format}`, b.size);
 }
-$("wire").onchange = redraw; $("handles").onchange = redraw; $("field").onchange = redraw;
+$("wire").onchange = redraw; $("handles").onchange = redraw;
+$("field").onchange = () => { updateLegend(); redraw(); };
+for (const id of ["stripes", "stripeangle"]) $(id).addEventListener("input", () => { updateLegend(); redraw(); });
+$("climit").addEventListener("input", () => { $("cauto").checked = false; updateLegend(); redraw(); });
+$("cauto").onchange = () => { updateLegend(); redraw(); };
+$("seam").onchange = () => { buildSeams(); redraw(); };
 $("time").addEventListener("input", () => { time = parseFloat($("time").value); changed(); });
 let playing = null;
 $("play").onclick = () => {

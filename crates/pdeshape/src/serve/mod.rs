@@ -474,6 +474,7 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
             "kind": p.kind.name(),
             "color": p.color,
             "vertices": m.positions.len(),
+            "grid": m.grid,
             "positions": positions, "normals": normals, "indices": indices, "lines": lines,
             "curves": curves, "fields": fields, "trim": trim,
         }));
