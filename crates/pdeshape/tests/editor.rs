@@ -246,6 +246,39 @@ async fn the_editor_shows_zebra_curvature_and_seam_continuity_in_chromium() {
         assert!((a - b).abs() < 1e-12, "camera target {target} vs marker {}", markers[0]["point"]);
     }
 
+    // a plane section at the middle of z: every cut point on the plane, with a curvature;
+    // combs on both trimlines of the six blends
+    js(&c, "document.getElementById('section').click(); return 0").await;
+    wait_for(
+        &c,
+        "the section",
+        "return !window.pdeshape.busy() && window.pdeshape.curves && window.pdeshape.curves.segments > 0",
+    )
+    .await;
+    let cut =
+        js(&c, "return [window.pdeshape.header.curves, parseFloat(document.getElementById('secval').textContent)]")
+            .await;
+    let mut points = 0;
+    for p in cut[0].as_array().unwrap() {
+        for seg in p["section"].as_array().unwrap() {
+            for i in [2, 8] {
+                let z = seg[i].as_f64().unwrap();
+                // the offset shown with 3 decimals; the points are on the exact plane
+                assert!((z - cut[1].as_f64().unwrap()).abs() < 6e-4, "{z} vs {}", cut[1]);
+                assert!(seg[i + 1].as_f64().is_some_and(f64::is_finite), "a curvature at every cut point");
+                points += 1;
+            }
+        }
+    }
+    assert!(points > 100, "{points} cut points");
+    js(&c, "document.getElementById('combs').click(); return 0").await;
+    wait_for(
+        &c,
+        "the combs",
+        "return !window.pdeshape.busy() && window.pdeshape.curves && window.pdeshape.curves.combs === 12",
+    )
+    .await;
+
     // live: a slider moved continuously for 3 s in the zebra view
     js(
         &c,
@@ -261,9 +294,20 @@ async fn the_editor_shows_zebra_curvature_and_seam_continuity_in_chromium() {
     js(&c, "clearInterval(window.__sweep); return 0").await;
     let dt = t0.elapsed().as_secs_f64();
     let n = js(&c, "return window.pdeshape.updates").await.as_u64().unwrap() - u0;
+    let t = js(
+        &c,
+        &format!(
+            "const t = window.pdeshape.timings.slice({u0}); const med = (xs) => xs.sort((a, b) => a - b)[xs.length >> 1];
+             return [med(t.map((x) => x.total)), med(t.map((x) => x.server))]"
+        ),
+    )
+    .await;
     eprintln!(
-        "live updates while dragging R in the zebra view (blend-cone-cylinder, 6 blends): {n} in {dt:.1} s = {:.1}/s",
-        n as f64 / dt
+        "live updates while dragging R in the zebra view (blend-cone-cylinder, 6 blends, section and combs on): \
+         {n} in {dt:.1} s = {:.1}/s; median request-to-upload {:.0} ms, of it solve and mesh on the server {:.0} ms",
+        n as f64 / dt,
+        t[0].as_f64().unwrap_or(f64::NAN),
+        t[1].as_f64().unwrap_or(f64::NAN)
     );
     assert!(n >= 3, "the view followed the slider {n} times in {dt:.1} s");
     c.close().await.unwrap();

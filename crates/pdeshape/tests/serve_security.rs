@@ -171,6 +171,29 @@ fn a_long_expression_is_an_error_not_an_abort() {
     assert_eq!(a.status, 200);
 }
 
+/// The curve tools' request is checked before any work: unknown axes and keys, non-finite
+/// offsets (a JSON number cannot be one, so a string) and `iso_u` outside [0, 1] are
+/// refused with a message naming the field; a good one answers.
+#[test]
+fn bad_curve_requests_are_refused_by_name() {
+    let (mut k, addr) = start(&[]);
+    let text = scene("blend-torus-hyperboloid.toml");
+    for (curves, status, says) in [
+        (serde_json::json!({"section": {"axis": "w", "offset": 0.0}}), 422, "curves.section.axis must be x, y or z"),
+        (serde_json::json!({"iso_u": 1.5}), 422, "curves.iso_u must be in [0, 1]"),
+        (serde_json::json!({"section": {"axis": "x", "offset": "inf"}}), 422, "offset"),
+        (serde_json::json!({"sections": 3}), 422, "unknown field `sections`"),
+    ] {
+        let a = post_json(&addr, "/api/model", &serde_json::json!({"text": text, "curves": curves}));
+        assert_eq!(a.status, status, "{curves}: {}", a.text());
+        assert!(a.text().contains(says), "{curves}: {}", a.text());
+    }
+    let good = serde_json::json!({"section": {"axis": "z", "offset": 0.2}, "combs": true, "iso_u": 0.5});
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": text, "curves": good}));
+    assert_eq!(a.status, 200);
+    assert!(k.0.try_wait().unwrap().is_none(), "the server died");
+}
+
 /// CPU seconds (user + system) the process has used, from /proc.
 fn cpu_seconds(pid: u32) -> f64 {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();

@@ -5,10 +5,12 @@
 //! all of them. Conditions ([`Condition`]) prescribe `∂ᵈX/∂uᵈ (uᵢ, v) = gᵢ(v)`.
 
 mod curvature;
+mod curves;
 mod hermite;
 mod primary;
 
 pub use curvature::{Curvature, CurvatureKind, curvature};
+pub use curves::{CurvePoint, iso_u_curve, plane_section, section_curvature};
 pub use hermite::{HermiteBasis, HermitePatch, HermitePatchError, Poly, cubic_hermite};
 pub use primary::PrimarySurface;
 

@@ -192,6 +192,7 @@ function draw() {
     gl.bindVertexArray(p.vao); gl.drawElements(gl.TRIANGLES, p.n, gl.UNSIGNED_INT, 0);
   });
   drawSeams(view, proj);
+  drawCurves(view, proj);
   gl.useProgram(flat);
   gl.uniformMatrix4fv(gl.getUniformLocation(flat, "view"), false, view);
   gl.uniformMatrix4fv(gl.getUniformLocation(flat, "proj"), false, proj);
@@ -373,6 +374,89 @@ function flyTo(p) {
 S.cam = cam;
 S.flyTo = flyTo;
 
+// ---------------- curves: plane section and curvature combs ----------------
+// The server computes them on the exact surface (points and curvature vectors, which point
+// to the centre of curvature); the teeth of a comb are drawn away from it, p − s k, with s
+// set so the 95th percentile of |k| gets `comb length` × a quarter of the model's size.
+function curvesRequest() {
+  const on = $("section").checked || $("combs").checked || $("isocomb").checked;
+  if (!on || !model) return undefined;
+  const b = bounds(model.patches), k = "xyz".indexOf($("secaxis").value);
+  const offset = b.lo[k] + parseFloat($("secpos").value) * (b.hi[k] - b.lo[k]);
+  $("secval").textContent = offset.toFixed(3);
+  return {
+    section: $("section").checked ? { axis: $("secaxis").value, offset } : undefined,
+    combs: $("combs").checked,
+    iso_u: $("isocomb").checked ? parseFloat($("isou").value) : undefined,
+  };
+}
+let curveVao = null, curveCount = 0;
+function buildCurves() {
+  const c = model && model.header.curves;
+  S.curves = null;
+  if (!c) { curveCount = 0; return; }
+  const b = bounds(model.patches);
+  const size = Math.hypot(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]);
+  const norms = [];
+  const kn = (k, i) => Math.hypot(k[i], k[i + 1], k[i + 2]);
+  for (const p of c) {
+    for (const s of p.section || []) for (const i of [3, 9]) if (s[i] !== null) norms.push(kn(s, i));
+    for (const m of p.combs || []) for (let i = 0; i < m.curvature.length; i += 3) if (m.curvature[i] !== null) norms.push(kn(m.curvature, i));
+  }
+  const kref = absQuantile([norms], 0.95) || 1;
+  const scale = parseFloat($("combscale").value) * 0.25 * size / kref;
+  const pos = [], col = [];
+  const line = (a, b, c) => { pos.push(...a, ...b); col.push(...c, ...c); };
+  const tip = (p, k) => [p[0] - scale * k[0], p[1] - scale * k[1], p[2] - scale * k[2]];
+  const heat = (k) => { const t = Math.min(1, Math.hypot(...k) / kref); return [0.1 + 0.9 * t, 0.25, 1 - 0.8 * t]; };
+  let segments = 0, teeth = 0, combs = 0;
+  for (const p of c) {
+    for (const s of p.section || []) {
+      const [a, ka, q, kq] = [s.slice(0, 3), s.slice(3, 6), s.slice(6, 9), s.slice(9, 12)];
+      const ok = ka[0] !== null && kq[0] !== null;
+      line(a, q, ok ? heat(ka) : [0.5, 0.5, 0.5]); segments++;
+      if (ok) { line(a, tip(a, ka), [0.35, 0.35, 0.45]); teeth++; }
+    }
+    for (const m of p.combs || []) {
+      combs++;
+      let prevTip = null;
+      for (let i = 0; i + 3 <= m.points.length; i += 3) {
+        const a = m.points.slice(i, i + 3), k = m.curvature.slice(i, i + 3);
+        if (i + 6 <= m.points.length) line(a, m.points.slice(i + 3, i + 6), [0.1, 0.1, 0.1]);
+        if (k[0] === null) { prevTip = null; continue; }
+        const t = tip(a, k);
+        if ((i / 3) % 2 === 0) { line(a, t, [0.2, 0.45, 0.85]); teeth++; }
+        if (prevTip) line(prevTip, t, [0.85, 0.3, 0.1]);
+        prevTip = t;
+      }
+    }
+  }
+  if (!curveVao) curveVao = gl.createVertexArray();
+  gl.bindVertexArray(curveVao);
+  for (const [arr, loc] of [[new Float32Array(pos), 0], [new Float32Array(col), 1]]) {
+    const buf = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, buf); gl.bufferData(gl.ARRAY_BUFFER, arr, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
+  }
+  gl.bindVertexArray(null);
+  curveCount = pos.length / 3;
+  S.curves = { segments, teeth, combs, kref };
+}
+function drawCurves(view, proj) {
+  if (!curveCount) return;
+  gl.useProgram(seamProg);
+  gl.uniformMatrix4fv(gl.getUniformLocation(seamProg, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(seamProg, "proj"), false, proj);
+  gl.disable(gl.DEPTH_TEST);
+  gl.bindVertexArray(curveVao); gl.drawArrays(gl.LINES, 0, curveCount);
+  gl.enable(gl.DEPTH_TEST);
+}
+for (const id of ["section", "secaxis", "secpos", "combs", "isocomb", "isou"]) {
+  $(id).addEventListener(id === "secpos" || id === "isou" ? "input" : "change", () => {
+    $("isouval").textContent = $("isou").value; changed();
+  });
+}
+$("combscale").addEventListener("input", () => { buildCurves(); redraw(); });
+
 // ---------------- server ----------------
 let edits = [];            // edits not yet folded into scene.text
 function showError(msg) {
@@ -382,8 +466,9 @@ function showError(msg) {
 async function solve(diagnostics) {
   if (inflight) { pending = true; wantDiag ||= diagnostics; return; }
   inflight = true;
-  const body = { text: scene.text, name: scene.name, params, edits, time, diagnostics };
+  const body = { text: scene.text, name: scene.name, params, edits, time, diagnostics, curves: curvesRequest() };
   const sent = edits; S.requests++;
+  const t0 = performance.now();
   try {
     const r = await fetch("/api/model", { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
     if (!r.ok) {
@@ -406,8 +491,10 @@ async function solve(diagnostics) {
       if (header.diagnostics) $("diag").textContent = summary(header.diagnostics);
       showError(null);
       if (first) { fit(); buildPanel(header); }
-      syncPanel(header); uploadHandles(); drawTrim(); buildSeams(); updateLegend(); redraw();
+      syncPanel(header); uploadHandles(); drawTrim(); buildSeams(); buildCurves(); updateLegend(); redraw();
       S.updates = (S.updates || 0) + 1;
+      // request to drawn-buffers time and the server's share, for the live-update figure
+      (S.timings ||= []).push({ total: performance.now() - t0, server: header.solve_ms });
       $("status").textContent = `${header.title || header.name}: ${S.vertexCount} vertices, solved in ${header.solve_ms.toFixed(1)} ms, hash ${header.hash}`;
     }
   } catch (e) { showError(String(e)); }

@@ -103,6 +103,110 @@ pub struct ModelRequest {
     /// Also compute `check`'s diagnostics (slower).
     #[serde(default)]
     pub diagnostics: bool,
+    /// Curves with exact curvature to draw: a plane section, curvature combs.
+    #[serde(default)]
+    pub curves: Option<CurvesRequest>,
+}
+
+/// The editor's curve tools (untrimmed, static patches: their `(u, v)` grid is the mesh).
+#[derive(Deserialize, Clone, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CurvesRequest {
+    /// The section plane `{axis: "x" | "y" | "z", offset}`: the points whose coordinate
+    /// `axis` equals `offset`.
+    #[serde(default)]
+    pub section: Option<SectionPlane>,
+    /// Curvature combs along each patch's position trimlines.
+    #[serde(default)]
+    pub combs: bool,
+    /// A comb along the isoparameter `u` (in [0, 1]) of every patch.
+    #[serde(default)]
+    pub iso_u: Option<f64>,
+}
+
+/// A section plane normal to a coordinate axis.
+#[derive(Deserialize, Clone, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct SectionPlane {
+    /// `x`, `y` or `z`.
+    pub axis: String,
+    /// The plane's coordinate on that axis.
+    pub offset: f64,
+}
+
+impl CurvesRequest {
+    /// Checks the request: a known axis, finite numbers, `iso_u` in [0, 1].
+    fn check(&self) -> Result<(), String> {
+        if let Some(s) = &self.section {
+            if !["x", "y", "z"].contains(&s.axis.as_str()) {
+                return Err(format!("curves.section.axis must be x, y or z, not `{}`", clip(&s.axis, 16)));
+            }
+            if !s.offset.is_finite() {
+                return Err("curves.section.offset must be finite".into());
+            }
+        }
+        if let Some(u) = self.iso_u
+            && !(0.0..=1.0).contains(&u)
+        {
+            return Err(format!("curves.iso_u must be in [0, 1], not {u}"));
+        }
+        Ok(())
+    }
+}
+
+/// The requested curves of every patch as JSON: per patch `{section: [[x, y, z, kx, ky, kz,
+/// x′, y′, z′, k′…]…], combs: [{u, points: [x, y, z…], curvature: [kx, ky, kz…]}…]}`
+/// (curvature vectors point to the centre of curvature; NaN becomes null where undefined).
+fn curves_json(scene: &Scene, c: &CurvesRequest) -> Value {
+    use pdeshape_core::patch::{CurvePoint, iso_u_curve, plane_section};
+    let flat = |pts: &[CurvePoint]| -> (Vec<f64>, Vec<f64>) {
+        let p = pts.iter().flat_map(|c| [c.point.x, c.point.y, c.point.z]).collect();
+        let k = pts.iter().flat_map(|c| [c.curvature.x, c.curvature.y, c.curvature.z]).collect();
+        (p, k)
+    };
+    let patches: Vec<Value> = scene
+        .patches
+        .iter()
+        .map(|p| {
+            if p.trim.is_some() || p.solid.is_some() || p.dynamic.is_some() {
+                return json!({"name": p.name});
+            }
+            let s = p.surface.as_ref();
+            let (nu, nv) = p.resolution;
+            let (us, vs) = pdeshape_core::mesh::grid_params(s, &pdeshape_core::mesh::GridOptions::new(nu, nv));
+            let section = c.section.as_ref().map(|sp| {
+                let a = match sp.axis.as_str() {
+                    "x" => pdeshape_core::Vec3::new(1.0, 0.0, 0.0),
+                    "y" => pdeshape_core::Vec3::new(0.0, 1.0, 0.0),
+                    _ => pdeshape_core::Vec3::new(0.0, 0.0, 1.0),
+                };
+                let segs = plane_section(s, &us, &vs, a * sp.offset, a);
+                segs.iter()
+                    .map(|[a, b]| {
+                        let (pa, ka) = flat(&[*a, *b]);
+                        [pa[..3].to_vec(), ka[..3].to_vec(), pa[3..].to_vec(), ka[3..].to_vec()].concat()
+                    })
+                    .collect::<Vec<_>>()
+            });
+            let mut comb_us: Vec<f64> = Vec::new();
+            if c.combs {
+                comb_us.extend(p.conditions.iter().filter(|k| k.order == 0).map(|k| k.u));
+            }
+            comb_us.extend(c.iso_u);
+            let n = (4 * nv).clamp(64, 1024);
+            let dom = s.v_domain();
+            let cvs: Vec<f64> = (0..=n).map(|k| dom.at(k as f64 / n as f64)).collect();
+            let combs: Vec<Value> = comb_us
+                .iter()
+                .map(|&u| {
+                    let (points, curvature) = flat(&iso_u_curve(s, u, &cvs));
+                    json!({"u": u, "points": points, "curvature": curvature})
+                })
+                .collect();
+            json!({"name": p.name, "section": section, "combs": combs})
+        })
+        .collect();
+    Value::Array(patches)
 }
 
 /// Runs the server until interrupted; prints the URL.
@@ -349,9 +453,13 @@ async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelReques
     // diagnostics and encoding run inside the limits too
     let r = limited(&s, arrived, move || {
         let t0 = Instant::now();
+        if let Some(c) = &req.curves {
+            c.check()?;
+        }
         let (scene, text, meshes) = solve(&req, &limits)?;
+        let curves = req.curves.as_ref().map(|c| curves_json(&scene, c));
         let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
-        Ok(encode(&solved, req.diagnostics))
+        Ok(encode(&solved, req.diagnostics, curves))
     })
     .await;
     match r {
@@ -400,7 +508,7 @@ async fn export_route(
 }
 
 /// The binary answer: `u32` header length, JSON header (padded to 4 bytes), buffers.
-fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
+fn encode(s: &Solved, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
     let mut buf: Vec<u8> = Vec::new();
     let put_f32 = |buf: &mut Vec<u8>, xs: &mut dyn Iterator<Item = f32>| -> Value {
         let offset = buf.len();
@@ -501,6 +609,7 @@ fn encode(s: &Solved, diagnostics: bool) -> Vec<u8> {
         "hash": model::mesh_hash(&s.meshes),
         "solve_ms": s.solve_ms,
         "diagnostics": if diagnostics { model::scene_diagnostics(&s.scene) } else { Value::Null },
+        "curves": curves,
     });
     let mut h = serde_json::to_vec(&header).expect("JSON of plain values");
     while !h.len().is_multiple_of(4) {

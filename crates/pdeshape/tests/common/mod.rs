@@ -21,16 +21,15 @@ pub fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
 }
 
-/// Starts `pdeshape serve [SCENE] --port 0` and returns it with the URL it printed.
+/// Starts `pdeshape serve [SCENE] --port 0` and returns it with the URL it printed. The
+/// binary is the one under test, or `PDESHAPE_SERVE_BIN` when set (to measure the editor
+/// against a release build).
 pub fn serve(scene: Option<&str>) -> (Kill, String) {
     let mut args: Vec<String> = scene.map(|s| example(s).to_string_lossy().into_owned()).into_iter().collect();
     args.extend(["--port".into(), "0".into()]);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
-        .arg("serve")
-        .args(&args)
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("pdeshape serve starts");
+    let bin = std::env::var("PDESHAPE_SERVE_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_pdeshape").to_string());
+    let mut child =
+        Command::new(bin).arg("serve").args(&args).stdout(Stdio::piped()).spawn().expect("pdeshape serve starts");
     let mut line = String::new();
     BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
     let url = line.trim().rsplit(' ').next().unwrap_or_default().to_string();
