@@ -364,6 +364,15 @@ pub fn render_scene(scene: &Scene) -> Result<Image, String> {
     render_scene_with(scene, &scene.render)
 }
 
+/// One curvature-map limit for several panels (so their colours compare): the 95th
+/// percentile of `|value|` over all their meshes; `None` for other views.
+fn shared_limit<'a>(r: &RenderSettings, meshes: impl Iterator<Item = &'a Mesh>) -> Option<f64> {
+    let k = r.view.curvature()?;
+    let values = meshes.filter_map(|m| m.field(k.field_name())).flat_map(|f| f.values.iter().copied());
+    let l = crate::render::abs_quantile(values, 0.95);
+    (l > 0.0).then_some(l)
+}
+
 /// [`render_scene`] with other render settings (e.g. another view).
 pub fn render_scene_with(scene: &Scene, r: &RenderSettings) -> Result<Image, String> {
     if let Some(strip) = blend_strip_with(scene, r) {
@@ -399,10 +408,11 @@ fn blend_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, 
         let w = (r0.size.0 * 2 / n.min(3)).clamp(64, 520);
         r.size = (w, w * 5 / 4);
         let caption_h = 118;
+        let meshes = scene.patches.iter().map(|p| view_mesh(p, None, &r)).collect::<Result<Vec<_>, _>>()?;
+        r.curvature_limit = r.curvature_limit.or_else(|| shared_limit(&r, meshes.iter().chain(&context)));
         let mut panels = Vec::new();
-        for (k, p) in scene.patches.iter().enumerate() {
-            let m = view_mesh(p, None, &r)?;
-            let img = render_meshes(std::slice::from_ref(&m), &context, &[p.color.or(Some(palette(k)))], &r);
+        for (k, (p, m)) in scene.patches.iter().zip(&meshes).enumerate() {
+            let img = render_meshes(std::slice::from_ref(m), &context, &[p.color.or(Some(palette(k)))], &r);
             let mut panel = Image::new(img.width, img.height + caption_h, [255, 255, 255]);
             panel.paste(&img, 0, 0);
             let d = patch_diagnostics(p);
@@ -448,12 +458,18 @@ fn dynamic_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image
         let mut r = r0.clone();
         let w = (r0.size.0 * 3 / times.len().max(3) as u32).clamp(64, 400);
         r.size = (w, w * 4 / 3);
-        let mut panels = Vec::new();
+        let mut frames = Vec::new();
         for &t in &times {
             let context = context_meshes_with(scene, t, r.view.curvature().as_slice())?;
             let meshes = scene.patches.iter().map(|p| view_mesh(p, Some(t), &r)).collect::<Result<Vec<_>, _>>()?;
-            let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
-            let img = render_meshes(&meshes, &context, &colors, &r);
+            frames.push((t, meshes, context));
+        }
+        let all = frames.iter().flat_map(|(_, m, c)| m.iter().chain(c));
+        r.curvature_limit = r.curvature_limit.or_else(|| shared_limit(&r, all));
+        let colors: Vec<_> = scene.patches.iter().map(|p| p.color).collect();
+        let mut panels = Vec::new();
+        for (t, meshes, context) in &frames {
+            let img = render_meshes(meshes, context, &colors, &r);
             panels.push(captioned(&img, &format!("t = {t:.2}"), 34, 22.0));
         }
         Ok(Image::strip(&panels, 4, [255, 255, 255]))
