@@ -312,3 +312,67 @@ async fn the_editor_shows_zebra_curvature_and_seam_continuity_in_chromium() {
     assert!(n >= 3, "the view followed the slider {n} times in {dt:.1} s");
     c.close().await.unwrap();
 }
+
+/// How fast the editor follows a dragged slider, per example and view: a figure to quote,
+/// not a pass/fail timing (run by hand, ideally against a release server:
+/// `PDESHAPE_SERVE_BIN=target/release/pdeshape cargo test -p pdeshape --test editor
+/// live_update_rates -- --ignored --nocapture`).
+#[tokio::test(flavor = "multi_thread")]
+#[ignore = "a measurement, printed; run by hand"]
+async fn live_update_rates() {
+    let Some((c, _driver)) = browser().await else { return };
+    for (scene, param, lo, hi) in [
+        ("klein-bottle.toml", "a", 0.8, 1.6),
+        ("bloor-wilson-blend.toml", "r", 0.8, 1.4),
+        ("four-curve-patch.toml", "", 0.0, 0.0),
+        ("blend-torus-hyperboloid.toml", "", 0.0, 0.0),
+        ("blend-cone-cylinder.toml", "R", 1.0, 1.4),
+    ] {
+        let (_server, url) = serve(Some(scene));
+        c.goto(&url).await.unwrap();
+        wait_for(&c, "the first frame", "return window.pdeshape.frames > 0 && window.pdeshape.vertexCount > 0").await;
+        let param = if param.is_empty() {
+            js(&c, "return document.querySelector('input[type=range][data-param]').dataset.param")
+                .await
+                .as_str()
+                .unwrap()
+                .to_string()
+        } else {
+            param.to_string()
+        };
+        for view in ["", "zebra", "mean_curvature"] {
+            js(&c, &format!("const f = document.getElementById('field'); f.value = '{view}'; f.dispatchEvent(new Event('change')); return 0")).await;
+            tokio::time::sleep(Duration::from_millis(500)).await;
+            let u0 = js(&c, "return window.pdeshape.updates").await.as_u64().unwrap();
+            let t0 = Instant::now();
+            js(&c, &format!(
+                "const s = document.querySelector('input[type=range][data-param={param}]'); let k = 0;
+                 const lo = {lo} || parseFloat(s.min), hi = {hi} || parseFloat(s.max), m = (lo + hi) / 2, a = (hi - lo) / 4;
+                 window.__sweep = setInterval(() => {{ s.value = m + a * Math.sin(k++ / 10); s.dispatchEvent(new Event('input')); }}, 16);
+                 return 0"
+            )).await;
+            tokio::time::sleep(Duration::from_secs(3)).await;
+            js(&c, "clearInterval(window.__sweep); return 0").await;
+            let dt = t0.elapsed().as_secs_f64();
+            wait_for(&c, "quiet", "return !window.pdeshape.busy()").await;
+            let n = js(&c, "return window.pdeshape.updates").await.as_u64().unwrap() - u0;
+            let t = js(
+                &c,
+                &format!(
+                    "const t = window.pdeshape.timings.slice({u0}); const med = (xs) => xs.sort((a, b) => a - b)[xs.length >> 1];
+                     return [med(t.map((x) => x.total)), med(t.map((x) => x.server)), window.pdeshape.vertexCount]"
+                ),
+            )
+            .await;
+            eprintln!(
+                "{scene} {param} view {:<15} {:>5.1} updates/s, median request-to-upload {:>4.0} ms (server {:>4.0} ms), {} vertices",
+                if view.is_empty() { "shading" } else { view },
+                n as f64 / dt,
+                t[0].as_f64().unwrap_or(f64::NAN),
+                t[1].as_f64().unwrap_or(f64::NAN),
+                t[2]
+            );
+        }
+    }
+    c.close().await.unwrap();
+}
