@@ -20,6 +20,7 @@ pub mod blend;
 pub mod cancel;
 pub mod data;
 pub mod expr;
+pub mod fill;
 pub mod jet;
 pub mod limits;
 pub mod linalg;

@@ -1,0 +1,156 @@
+//! The boundary data of an N-sided fill along its loop: positions and cross tangents taken
+//! from the neighbouring surfaces, with the cross tangent rotated within each neighbour's
+//! tangent plane near the corners so that it is continuous (see the module `fill`).
+
+use crate::Vec3;
+use crate::data::{Field, FieldRef, VecJet};
+use crate::jet::{Jet, JetShape};
+use std::f64::consts::TAU;
+
+/// One edge of the loop: the isoline `s = s0` of a neighbour `S(s, w, t)` from `w0` to `w1`,
+/// traversed by the fill's `v ∈ [V_k, V_{k+1}]` (`V_k = 2πk/N`) through
+/// `w(v) = w0 + λ (v − V_k)`, `λ = (w1 − w0) N / 2π`.
+#[derive(Clone, Debug)]
+pub(crate) struct Piece {
+    pub surface: FieldRef,
+    pub s0: f64,
+    pub w0: f64,
+    pub lambda: f64,
+    /// The cross tangent along the edge, away from the corners: `c S_s`.
+    pub c: f64,
+    /// At the start corner: `T_c = a S_s + b S_w` there; likewise at the end corner.
+    pub start: (f64, f64),
+    pub end: (f64, f64),
+}
+
+/// `1 − (35x⁴ − 84x⁵ + 70x⁶ − 20x⁷)` on `[0, 1]`, 0 beyond: 1 at the corner, 0 at the
+/// blend's end, with three vanishing derivatives at both ends (C³ joins). Returns the
+/// Taylor coefficients in `v` (`x = (v − v_c)/h` or its mirror, `dx/dv = slope`) up to
+/// `order`.
+fn bump(x: f64, slope: f64, order: usize) -> Vec<f64> {
+    let mut out = vec![0.0; order + 1];
+    if !(0.0..1.0).contains(&x) {
+        return out;
+    }
+    // p(x) = 1 − 35x⁴ + 84x⁵ − 70x⁶ + 20x⁷ as coefficients in x
+    let p = [1.0, 0.0, 0.0, 0.0, -35.0, 84.0, -70.0, 20.0];
+    // Taylor coefficients at x: p⁽ᵏ⁾(x)/k!, then scaled by slopeᵏ
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut acc = 0.0;
+        for (n, &a) in p.iter().enumerate().skip(k) {
+            // C(n, k) x^(n−k)
+            let binom = (0..k).fold(1.0, |b, i| b * (n - i) as f64 / (i + 1) as f64);
+            acc += a * binom * x.powi((n - k) as i32);
+        }
+        *o = acc * slope.powi(k as i32);
+    }
+    out
+}
+
+/// Cauchy product of truncated series.
+fn mul(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let n = a.len().min(b.len());
+    (0..n).map(|k| (0..=k).map(|i| a[i] * b[k - i]).sum()).collect()
+}
+
+/// The loop data: `order` 0 (position) or 1 (cross tangent).
+#[derive(Clone, Debug)]
+pub(crate) struct LoopData {
+    pub pieces: Vec<Piece>,
+    pub order: usize,
+    /// The corner blend's half-width as a fraction of an edge's `v`-range (≤ ½).
+    pub blend: f64,
+}
+
+impl LoopData {
+    /// The edge holding `v` (taken modulo 2π; a corner belongs to the edge it starts) and
+    /// `v − V_k`.
+    fn locate(&self, v: f64) -> (usize, f64) {
+        let n = self.pieces.len();
+        let dv = TAU / n as f64;
+        let v = v.rem_euclid(TAU);
+        let k = ((v / dv).floor() as usize).min(n - 1);
+        (k, v - k as f64 * dv)
+    }
+
+    /// Taylor coefficients in `v` (up to `order`) of the three components, at `v`.
+    pub fn series(&self, v: f64, t: f64, order: usize) -> [Vec<f64>; 3] {
+        let (k, dv) = self.locate(v);
+        let p = &self.pieces[k];
+        let w = p.w0 + p.lambda * dv;
+        let sj = p.surface.jet(&[p.s0, w, t], JetShape::new(&[1, order + 1, 0]));
+        let lam_pow: Vec<f64> = (0..=order + 1).map(|j| p.lambda.powi(j as i32)).collect();
+        if self.order == 0 {
+            return std::array::from_fn(|c| (0..=order).map(|j| sj.0[c].coeff([0, j, 0]) * lam_pow[j]).collect());
+        }
+        // weights of S_s and S_w: α = (1 − ω_s − ω_e) c + ω_s a_s + ω_e a_e, β = ω_s b_s + ω_e b_e
+        let span = TAU / self.pieces.len() as f64;
+        let h = self.blend * span;
+        let ws = bump(dv / h, 1.0 / h, order);
+        let we = bump((span - dv) / h, -1.0 / h, order);
+        let alpha: Vec<f64> = (0..=order)
+            .map(|j| {
+                let one = if j == 0 { 1.0 } else { 0.0 };
+                (one - ws[j] - we[j]) * p.c + ws[j] * p.start.0 + we[j] * p.end.0
+            })
+            .collect();
+        let beta: Vec<f64> = (0..=order).map(|j| ws[j] * p.start.1 + we[j] * p.end.1).collect();
+        std::array::from_fn(|c| {
+            // S_s(s0, w(v)) and S_w(s0, w(v)) as series in v
+            let ss: Vec<f64> = (0..=order).map(|j| sj.0[c].coeff([1, j, 0]) * lam_pow[j]).collect();
+            let sw: Vec<f64> =
+                (0..=order).map(|j| (j + 1) as f64 * sj.0[c].coeff([0, j + 1, 0]) * lam_pow[j]).collect();
+            let a = mul(&alpha, &ss);
+            let b = mul(&beta, &sw);
+            a.iter().zip(&b).map(|(x, y)| x + y).collect()
+        })
+    }
+
+    /// The neighbour's point, `S_s` and `S_w` at the loop's `v` (for diagnostics).
+    pub fn frame(&self, v: f64, t: f64) -> (Vec3, Vec3, Vec3) {
+        let (k, dv) = self.locate(v);
+        let p = &self.pieces[k];
+        let j = p.surface.jet(&[p.s0, p.w0 + p.lambda * dv, t], JetShape::new(&[1, 1, 0]));
+        let g = |m: [usize; 3]| Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m));
+        (g([0, 0, 0]), g([1, 0, 0]), g([0, 1, 0]))
+    }
+}
+
+impl Field for LoopData {
+    fn arity(&self) -> usize {
+        2
+    }
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let [ov, _, _] = shape.orders();
+        let t = at.get(1).copied().unwrap_or(0.0);
+        let s = self.series(at[0], t, ov);
+        // the fill is static: no t-dependence (its neighbours are taken at the given t)
+        VecJet(std::array::from_fn(|c| {
+            let coeffs: Vec<f64> = shape.multi_indices().map(|[j, l, _]| if l == 0 { s[c][j] } else { 0.0 }).collect();
+            Jet::from_coeffs(shape, coeffs)
+        }))
+    }
+    fn is_constant_in(&self, slot: usize) -> bool {
+        slot == 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_bump_is_one_at_the_corner_zero_beyond_and_c3() {
+        let b0 = bump(0.0, 1.0, 4);
+        assert_eq!(b0, vec![1.0, 0.0, 0.0, 0.0, -35.0]);
+        let b1 = bump(1.0 - 1e-12, 1.0, 3);
+        assert!(b1.iter().all(|x| x.abs() < 1e-9), "{b1:?}");
+        assert_eq!(bump(1.5, 1.0, 2), vec![0.0; 3]);
+        // Taylor coefficients against the closed-form derivative at x = 0.3, slope 2:
+        // p′(x) = −140x³ + 420x⁴ − 420x⁵ + 140x⁶
+        let x: f64 = 0.3;
+        let d1 = -140.0 * x.powi(3) + 420.0 * x.powi(4) - 420.0 * x.powi(5) + 140.0 * x.powi(6);
+        let b = bump(x, 2.0, 1);
+        assert!((b[1] - 2.0 * d1).abs() < 1e-14, "{} vs {}", b[1], 2.0 * d1);
+    }
+}
