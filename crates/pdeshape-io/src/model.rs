@@ -2,7 +2,9 @@
 
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
-use pdeshape_core::blend::{DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, gaps_at, seam_gaps};
+use pdeshape_core::blend::{
+    DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, attached_gaps_at, attached_seam_gaps, gaps_at, seam_gaps,
+};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
 use pdeshape_core::num::MaxNan;
@@ -54,6 +56,8 @@ fn unchecked_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     }
     if let Some(b) = &p.blend {
         add_continuity_fields(&mut m, p, b.blend.as_ref());
+    } else if p.trim.is_none() && p.dynamic.is_none() {
+        add_attached_fields(&mut m, p);
     }
     if let Some(d) = &p.dynamic {
         m.animation = Some(dynamic_animation(p, d)?);
@@ -179,6 +183,48 @@ fn add_continuity_fields(m: &mut Mesh, p: &ScenePatch, s: &dyn pdeshape_core::pa
             m.fields.push(ScalarField { name: name.into(), values });
         }
     }
+}
+
+/// Per-vertex seam fields of a patch attached to trim curves ([`attached_ends`]): at each
+/// vertex, `c0_gap` and `g1_angle` of its `v` on the nearest attached end.
+fn add_attached_fields(m: &mut Mesh, p: &ScenePatch) {
+    use rayon::prelude::*;
+    let ends = attached_ends(p);
+    let Some((nu, nv)) = m.grid.filter(|(nu, nv)| nu * nv == m.uvs.len()) else { return };
+    if ends.is_empty() {
+        return;
+    }
+    let s = p.surface.as_ref();
+    let dom = s.v_domain();
+    // the attached end nearest to each row
+    let near =
+        |u: f64| ends.iter().enumerate().min_by(|a, b| (a.1.0 - u).abs().total_cmp(&(b.1.0 - u).abs())).unwrap().0;
+    let seams: Vec<Gaps> = (0..ends.len() * nv)
+        .into_par_iter()
+        .map(|k| {
+            let (u, data) = &ends[k / nv];
+            attached_gaps_at(s, *u, dom.at(m.uvs[k % nv][1]), data)
+        })
+        .collect();
+    let gaps: Vec<Gaps> = (0..nu * nv).map(|k| seams[near(m.uvs[k][0]) * nv + k % nv]).collect();
+    for (name, pick) in [("c0_gap", (|g: &Gaps| g.c0) as fn(&Gaps) -> Option<f64>), ("g1_angle", |g| g.g1)] {
+        if gaps.iter().all(|g| pick(g).is_some()) {
+            let values = gaps.iter().map(|g| pick(g).unwrap_or(0.0)).collect();
+            m.fields.push(ScalarField { name: name.into(), values });
+        }
+    }
+}
+
+/// The ends (`u` values) of a patch that are seams with other patches: both trimlines of a
+/// blend, the attached ends of a patch on trim curves ([`attached_ends`]).
+pub fn seam_ends(p: &ScenePatch) -> Vec<f64> {
+    if p.blend.is_some() {
+        return vec![0.0, 1.0];
+    }
+    if p.trim.is_some() || p.dynamic.is_some() || p.solid.is_some() {
+        return Vec::new();
+    }
+    attached_ends(p).iter().map(|e| e.0).collect()
 }
 
 /// The hexahedral volume mesh of a solid patch (`None` for other patches).
@@ -813,6 +859,8 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
     }
     if let Some(b) = &p.blend {
         blend_diagnostics(p, b, &mut d, rep.size);
+    } else if p.dynamic.is_none() && p.trim.is_none() && !attached_ends(p).is_empty() {
+        attached_diagnostics(p, &mut d, rep.size);
     }
     if !dyn_json.is_null() {
         d["dynamic"] = dyn_json;
@@ -959,6 +1007,41 @@ fn gaps_json(g: &Gaps) -> Value {
         put(&mut o, k, v);
     }
     o
+}
+
+/// The ends `u = 0`, `u = 1` of a (non-blend) patch whose position there is a curve on
+/// another surface (a trim curve of an earlier patch: a fin on a body), with that data.
+pub fn attached_ends(p: &ScenePatch) -> Vec<(f64, FieldRef)> {
+    if p.blend.is_some() {
+        return Vec::new();
+    }
+    p.conditions
+        .iter()
+        .filter(|c| c.order == 0 && (c.u == 0.0 || c.u == 1.0) && c.data.host_normal(&[0.0, 0.0]).is_some())
+        .map(|c| (c.u, c.data.clone()))
+        .collect()
+}
+
+/// The seams of a patch attached to other patches' trim curves: position gap and G1 angle
+/// against the host surface at 400 points, the class and the worst places, under
+/// `continuity` (`start` for `u = 0`, `end` for `u = 1`; `with`: "trim curve").
+fn attached_diagnostics(p: &ScenePatch, d: &mut Value, size: f64) {
+    let s = p.surface.as_ref();
+    let ends = attached_ends(p);
+    let seams: Vec<SeamGaps> = ends.iter().map(|(u, data)| attached_seam_gaps(s, *u, data, 400)).collect();
+    let mut c = json!({
+        "class": continuity_class(&seams.iter().map(|g| g.max).collect::<Vec<_>>(), size),
+        "samples": 400,
+        "with": "trim curve",
+    });
+    // worst_json names the ends by their index: put each seam where its u says
+    let mut by_end = [SeamGaps::default(), SeamGaps::default()];
+    for ((u, _), g) in ends.iter().zip(&seams) {
+        c[if *u == 0.0 { "start" } else { "end" }] = gaps_json(&g.max);
+        by_end[usize::from(*u == 1.0)] = *g;
+    }
+    c["worst"] = worst_json(s, &by_end);
+    d["continuity"] = c;
 }
 
 /// Per measure, the worst place over both trimlines: `{value, end, u, v, point}` (the

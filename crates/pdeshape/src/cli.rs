@@ -289,12 +289,16 @@ pub fn continuity_line(p: &serde_json::Value) -> Option<String> {
             f(&e["g2"])
         )
     };
-    let mut line = format!(
-        "continuity {}: u=0 [{}]  u=1 [{}]",
-        c["class"].as_str().unwrap_or("?"),
-        end(&c["start"]),
-        end(&c["end"])
-    );
+    let mut line = format!("continuity {}:", c["class"].as_str().unwrap_or("?"));
+    if let Some(with) = c["with"].as_str() {
+        line.push_str(&format!(" (with a {with})"));
+    }
+    for (key, u) in [("start", 0), ("end", 1)] {
+        if c[key].is_object() {
+            line.push_str(&format!(" u={u} [{}] ", end(&c[key])));
+        }
+    }
+    let mut line = line.trim_end().to_string();
     let w = &c["worst"]["g1_radians"];
     if let (Some(u), Some(v)) = (w["u"].as_f64(), w["v"].as_f64()) {
         line.push_str(&format!("; worst G1 angle {} rad at (u, v) = ({u}, {v:.4})", f(&w["value"])));

@@ -77,8 +77,32 @@ fn dolphin_fins_start_on_the_body() {
             let gap = (f.surface.point(0.0, s) - body.surface.point(uv[0], uv[1])).norm();
             assert!(gap < 1e-10, "{fin} at t = {s}: {gap}");
         }
+        // the seam report: no position gap; the G1 angle between the fin's and the body's
+        // normal lines, checked at the worst place against the normals by hand
+        let cont = &d["continuity"];
+        assert_eq!(cont["with"], "trim curve", "{fin}: {cont}");
+        assert_eq!(cont["class"], "C0", "{fin}: a fin stands on the body at an angle");
+        assert!(cont["start"]["c0"].as_f64().unwrap() < 1e-10, "{fin}: {cont}");
+        assert!(cont["end"].is_null(), "{fin}: only the root is a seam");
+        let w = &cont["worst"]["g1_radians"];
+        let (u, v) = (w["u"].as_f64().unwrap(), w["v"].as_f64().unwrap());
+        assert_eq!(u, 0.0);
+        let df = f.surface.derivatives(0.0, v, 1, 1);
+        let uv = c.point(v);
+        let db = body.surface.derivatives(uv[0], uv[1], 1, 1);
+        let (nf, nb) = (df[2].cross(df[1]), db[2].cross(db[1]));
+        let want = (nf.dot(nb).abs() / (nf.norm() * nb.norm())).acos();
+        let got = w["value"].as_f64().unwrap();
+        // acos is well conditioned away from 0 and π (the angles here are ~1.5 rad)
+        assert!((got - want).abs() < 1e-12 && got > 0.3, "{fin}: {got} vs {want}");
+        assert_eq!(got, cont["start"]["g1_radians"].as_f64().unwrap());
+        // the editor's mesh colours the root row by the same measure
+        let m = model::editor_mesh(f, None).unwrap();
+        assert!(m.field("g1_angle").is_some() && m.field("c0_gap").is_some(), "{fin}");
+        assert_eq!(model::seam_ends(f), vec![0.0]);
     }
     assert!(scene.patch("flukes").is_some());
+    assert!(model::seam_ends(body).is_empty() && model::patch_diagnostics(body)["continuity"].is_null());
 }
 
 fn fails(scene: &str, expect: &[&str]) {

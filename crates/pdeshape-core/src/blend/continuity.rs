@@ -100,14 +100,38 @@ pub struct SeamGaps {
     pub at: Gaps,
 }
 
+/// The gaps of a patch `X` attached along `u = u_e` to a curve `g` that lies on another
+/// surface ([`crate::data::Field::host_normal`]; a trim curve of another patch): the
+/// position gap `|X − g|` (C0) and the angle between the normal lines of `X` and of the
+/// host surface (G1; an unsigned angle in `[0, π/2]`, as the two normals' orientations are
+/// unrelated). `None` entries where the data have no host.
+pub fn attached_gaps_at(x: &dyn Surface, u_e: f64, v: f64, data: &FieldRef) -> Gaps {
+    let d = x.derivatives(u_e, v, 1, 1);
+    let mut g = Gaps { c0: Some((d[0] - data.eval(&[v, 0.0])).norm()), ..Gaps::default() };
+    g.g1 = data.host_normal(&[v, 0.0]).and_then(|h| {
+        let (a, b) = (d[2].cross(d[1]).normalized()?, h.normalized()?);
+        Some(a.cross(b).norm().atan2(a.dot(b).abs()))
+    });
+    g
+}
+
+/// [`seam_gaps`] of a patch attached to a curve on another surface ([`attached_gaps_at`]).
+pub fn attached_seam_gaps(x: &dyn Surface, u_e: f64, data: &FieldRef, samples: usize) -> SeamGaps {
+    seam_with(x, samples, |v| attached_gaps_at(x, u_e, v, data))
+}
+
 /// The gaps at `samples` points `v = start + (i + ½)/samples · (end − start)` of the
 /// trimline `u = u_e`, their maxima and where the maxima are.
 pub fn seam_gaps(x: &dyn Surface, u_e: f64, data: [Option<&FieldRef>; 3], samples: usize) -> SeamGaps {
+    seam_with(x, samples, |v| gaps_at(x, u_e, v, data))
+}
+
+fn seam_with(x: &dyn Surface, samples: usize, gaps: impl Fn(f64) -> Gaps) -> SeamGaps {
     let dom = x.v_domain();
     let mut out = SeamGaps::default();
     for i in 0..samples {
         let v = dom.at((i as f64 + 0.5) / samples as f64);
-        let g = gaps_at(x, u_e, v, data);
+        let g = gaps(v);
         let take = |best: &mut Option<f64>, at: &mut Option<f64>, new: Option<f64>| {
             if let Some(y) = new {
                 let replace = match *best {

@@ -93,6 +93,13 @@ pub trait Field: Send + Sync + Debug {
         false
     }
 
+    /// For a curve that lies on another surface (a trim curve carried onto its patch): that
+    /// surface's normal (not normalised) at the curve's point `at`, so a patch attached
+    /// along the curve can be compared with it (seam continuity). `None` for other data.
+    fn host_normal(&self, _at: &[f64]) -> Option<Vec3> {
+        None
+    }
+
     /// The component expressions with their variable names, for fields defined by
     /// expressions (used to expand boundary data into basis functions, SPEC §5).
     fn expressions(&self) -> Option<(&[crate::expr::Expr; 3], &[String])> {

@@ -81,4 +81,11 @@ impl Field for CurveOnSurface {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot > 0
     }
+
+    /// `X_u × X_v` of the trimmed patch at `C(t)`.
+    fn host_normal(&self, at: &[f64]) -> Option<Vec3> {
+        let [u, v] = self.curve.point(at[0]);
+        let d = self.surface.derivatives(u, v, 1, 1);
+        Some(d[2].cross(d[1]))
+    }
 }

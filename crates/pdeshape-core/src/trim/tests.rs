@@ -217,6 +217,43 @@ fn curve_on_surface_has_exact_derivatives() {
     assert!((j.derivative([1, 0, 0]).z - z1).abs() < 1e-14);
     assert!((j.derivative([2, 0, 0]).z - z2).abs() < 1e-13);
     assert!((j.derivative([2, 0, 0]).x - ddu).abs() < 1e-14);
+
+    // the host normal is the paraboloid's, X_u × X_v = (−2uv, −u², 1), at C(t)
+    let h = g.host_normal(&[t]).unwrap();
+    assert!((h - Vec3::new(-2.0 * u * v, -u * u, 1.0)).norm() < 1e-15, "{h:?}");
+    // a vertical wall W(s, τ) = g(τ) + s (0, 0, 1) attached along g: no position gap, and
+    // the angle between its normal line (0, 0, 1) × g′ and the host's, by hand
+    struct Wall(CurveOnSurface);
+    impl Surface for Wall {
+        fn v_domain(&self) -> VDomain {
+            VDomain::PERIODIC
+        }
+        fn derivatives(&self, s: f64, tau: f64, du: usize, dv: usize) -> Vec<Vec3> {
+            let j = self.0.jet(&[tau], JetShape::new(&[dv]));
+            let mut out = Vec::new();
+            for i in 0..=du {
+                for k in 0..=dv {
+                    let c = j.derivative([k, 0, 0]);
+                    out.push(match (i, k) {
+                        (0, _) => c + if k == 0 { Vec3::new(0.0, 0.0, s) } else { Vec3::ZERO },
+                        (1, 0) => Vec3::new(0.0, 0.0, 1.0),
+                        _ => Vec3::ZERO,
+                    });
+                }
+            }
+            out
+        }
+    }
+    let field: crate::data::FieldRef = std::sync::Arc::new(g.clone());
+    let wall = Wall(g);
+    let gaps = crate::blend::attached_gaps_at(&wall, 0.0, t, &field);
+    assert_eq!(gaps.c0, Some(0.0));
+    let nw = Vec3::new(-(0.1 * t.cos()), -0.2 * t.sin(), 0.0); // (0,0,1) × (u′, v′, ·)
+    let nh = Vec3::new(-2.0 * u * v, -u * u, 1.0);
+    let want = (nw.dot(nh).abs() / (nw.norm() * nh.norm())).acos();
+    let got = gaps.g1.unwrap();
+    assert!((got - want).abs() < 1e-14 && want > 0.5, "{got} vs {want}");
+    assert!(gaps.c1.is_none() && gaps.c2.is_none() && gaps.g2.is_none());
 }
 
 /// Points at radius `r(θ_k)`, `θ_k = 2πk/n`, about `c`.

@@ -271,7 +271,8 @@ function updateLegend() {
   $("legendlo").textContent = fmt(scale.lo); $("legendmid").textContent = fmt(mid); $("legendhi").textContent = fmt(scale.hi);
   S.legend = { title: $("legendtitle").textContent, lo: scale.lo, mid, hi: scale.hi };
 }
-// Seams: the first and last rows (u = 0 and u = 1) of a blend's grid, coloured by a
+// Seams: the rows of the seam ends the server lists (both trimlines of a blend, the ends of
+// a patch attached to another's trim curve), coloured by a
 // continuity field (green at round-off, 1e-12, through yellow to red at 1e-1 and above,
 // on a log scale); the worst place per patch from check's diagnostics, marked and listed.
 const SEAM_KEYS = { g1_angle: ["g1_radians", "G1 angle", " rad"], c0_gap: ["c0", "C0 gap", ""],
@@ -291,7 +292,7 @@ function buildSeams() {
     const f = p.fields[key], g = p.meta.grid;
     if (!f || !g) continue;
     const [nu, nv] = g;
-    for (const i of [0, nu - 1]) {
+    for (const i of (p.meta.seams || []).map((u) => Math.round(u * (nu - 1)))) {
       const pos = new Float32Array(nv * 3), col = new Float32Array(nv * 3);
       let worst = -Infinity;
       for (let j = 0; j < nv; j++) {
@@ -307,7 +308,7 @@ function buildSeams() {
       }
       gl.bindVertexArray(null);
       seamVaos.push({ vao, n: nv });
-      S.seams.push({ patch: p.meta.name, u: i === 0 ? 0 : 1, field: key, max: worst });
+      S.seams.push({ patch: p.meta.name, u: i / (nu - 1), field: key, max: worst });
     }
   }
   buildMarkers();

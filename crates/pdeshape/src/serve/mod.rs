@@ -583,6 +583,7 @@ fn encode(s: &Solved, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
             "color": p.color,
             "vertices": m.positions.len(),
             "grid": m.grid,
+            "seams": model::seam_ends(p),
             "positions": positions, "normals": normals, "indices": indices, "lines": lines,
             "curves": curves, "fields": fields, "trim": trim,
         }));
