@@ -815,7 +815,7 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         "kind": p.kind.name(),
         "solver": match (&p.kind, &p.blend) {
             (crate::scene::PatchKind::Hermite, _) => "hermite-interpolation".to_string(),
-            (crate::scene::PatchKind::Pde, _) => "spectral".to_string(),
+            (crate::scene::PatchKind::Pde | crate::scene::PatchKind::Fill, _) => "spectral".to_string(),
             (_, Some(b)) => blend_solver_name(b.blend.as_ref()),
             (_, None) => p.dynamic.as_ref().and_then(|d| d.blend.frame(d.times.0).ok()).map(|f| f.report().solver.to_string()).unwrap_or_else(|| "none".into()),
         },
@@ -861,6 +861,29 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
         blend_diagnostics(p, b, &mut d, rep.size);
     } else if p.dynamic.is_none() && p.trim.is_none() && !attached_ends(p).is_empty() {
         attached_diagnostics(p, &mut d, rep.size);
+    }
+    if let Some(f) = &p.fill {
+        let r = f.report();
+        let e = f.edge_continuity(1000);
+        d["fill"] = json!({
+            "edges": r.corner_angles.len(),
+            "edge_samples": e.samples,
+            "g1_max_radians": e.g1,
+            "gap_max_relative": e.gap,
+            "corner_normal_angles_radians": r.corner_angles,
+            "folds": f.folds(41, 400),
+            "pole": [r.pole.x, r.pole.y, r.pole.z],
+            "loop_radius": r.radius,
+        });
+        if let Some(w) = d["warnings"].as_array_mut() {
+            for (k, a) in r.corner_angles.iter().enumerate() {
+                if a.is_nan() || *a > 1e-9 {
+                    w.push(json!(format!(
+                        "corner {k}: the neighbours' tangent planes differ by {a:.2e} rad there, so no surface meets both G1 at that corner"
+                    )));
+                }
+            }
+        }
     }
     if !dyn_json.is_null() {
         d["dynamic"] = dyn_json;
@@ -1032,7 +1055,7 @@ fn attached_diagnostics(p: &ScenePatch, d: &mut Value, size: f64) {
     let mut c = json!({
         "class": continuity_class(&seams.iter().map(|g| g.max).collect::<Vec<_>>(), size),
         "samples": 400,
-        "with": "trim curve",
+        "with": if p.fill.is_some() { "neighbouring surface" } else { "trim curve" },
     });
     // worst_json names the ends by their index: put each seam where its u says
     let mut by_end = [SeamGaps::default(), SeamGaps::default()];

@@ -588,6 +588,18 @@ fn print_check(sc: &Scene, d: &serde_json::Value) {
         if let Some(line) = continuity_line(p) {
             println!("      {line}");
         }
+        let f = &p["fill"];
+        if f.is_object() {
+            println!(
+                "      fill: {} edges, {} points: G1 angle ≤ {:.1e} rad, gap ≤ {:.1e} (relative); folds {}; pole {}",
+                f["edges"],
+                f["edge_samples"],
+                f["g1_max_radians"].as_f64().unwrap_or(f64::NAN),
+                f["gap_max_relative"].as_f64().unwrap_or(f64::NAN),
+                f["folds"],
+                f["pole"],
+            );
+        }
         if let (Some(so), Some(mp)) = (p["solid"].as_object(), p["mass_properties"].as_object()) {
             println!(
                 "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",

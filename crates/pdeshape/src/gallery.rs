@@ -65,9 +65,9 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
             return e;
         }
     }
-    // blends beside their zebra picture: the stripes show the seams' continuity (a jump at
-    // C0, a kink at G1/C1, smooth at G2/C2) on the blends and their primary surfaces
-    if scene.patches.iter().any(|p| p.blend.is_some() || p.dynamic.is_some()) {
+    // blends and fills beside their zebra picture: the stripes show the seams' continuity (a
+    // jump at C0, a kink at G1/C1, smooth at G2/C2) on the patches and their neighbours
+    if scene.patches.iter().any(|p| p.blend.is_some() || p.dynamic.is_some() || p.fill.is_some()) {
         let zebra =
             pdeshape_io::scene::RenderSettings { view: pdeshape_io::render::View::Zebra, ..scene.render.clone() };
         match model::render_scene_with(&scene, &zebra) {

@@ -41,7 +41,7 @@ fn every_example_builds_and_meets_its_conditions() {
 }
 
 /// The examples of the repository, in file-name order.
-const EXAMPLES: [&str; 21] = [
+const EXAMPLES: [&str; 24] = [
     "blend-cone-cylinder",
     "blend-torus-hyperboloid",
     "bloor-wilson-blend",
@@ -49,6 +49,9 @@ const EXAMPLES: [&str; 21] = [
     "dynamic-elliptic-cylinders",
     "dynamic-linear",
     "dynamic-sine",
+    "fill-sphere-hexagon",
+    "fill-sphere-pentagon",
+    "fill-sphere-triangle",
     "four-curve-patch",
     "hermite-blend",
     "hermite-pole",

@@ -106,6 +106,14 @@ impl LoopData {
         })
     }
 
+    /// The values of the cross tangent's weights `(α, β)` on piece `p` at `v − V_k = dv`.
+    fn weights(&self, p: &Piece, dv: f64) -> (f64, f64) {
+        let span = TAU / self.pieces.len() as f64;
+        let h = self.blend * span;
+        let (ws, we) = (bump(dv / h, 1.0, 0)[0], bump((span - dv) / h, 1.0, 0)[0]);
+        ((1.0 - ws - we) * p.c + ws * p.start.0 + we * p.end.0, ws * p.start.1 + we * p.end.1)
+    }
+
     /// The neighbour's point, `S_s` and `S_w` at the loop's `v` (for diagnostics).
     pub fn frame(&self, v: f64, t: f64) -> (Vec3, Vec3, Vec3) {
         let (k, dv) = self.locate(v);
@@ -133,11 +141,93 @@ impl Field for LoopData {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot == 1
     }
+    fn eval(&self, at: &[f64]) -> Vec3 {
+        let mut out = [Vec3::ZERO];
+        self.derivatives_in(at, 0, &mut out);
+        out[0]
+    }
+    /// The fast paths (the neighbours' compiled one-slot derivatives, no jets): positions
+    /// to any order along `v` (`dʲ/dvʲ S(s₀, w(v)) = λʲ ∂ʲS/∂wʲ`), the cross tangent's value
+    /// (`α S_s + β S_w` from one derivative along `s` and one along `w`); the rest through
+    /// the jets.
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        let t = at.get(1).copied().unwrap_or(0.0);
+        if slot == 1 {
+            out.iter_mut().enumerate().for_each(|(k, o)| *o = if k == 0 { self.eval(at) } else { Vec3::ZERO });
+            return;
+        }
+        let (k, dv) = self.locate(at[0]);
+        let p = &self.pieces[k];
+        let on = [p.s0, p.w0 + p.lambda * dv, t];
+        if self.order == 0 {
+            p.surface.derivatives_in(&on, 1, out);
+            let mut f = 1.0;
+            for o in out.iter_mut().skip(1) {
+                f *= p.lambda;
+                *o = *o * f;
+            }
+        } else if out.len() == 1 {
+            let (mut along_s, mut along_w) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2]);
+            p.surface.derivatives_in(&on, 0, &mut along_s);
+            p.surface.derivatives_in(&on, 1, &mut along_w);
+            let (alpha, beta) = self.weights(p, dv);
+            out[0] = along_s[1] * alpha + along_w[1] * beta;
+        } else {
+            crate::data::derivatives_by_jet(self, at, slot, out);
+        }
+    }
+    /// The neighbour's `S_s × S_w` at the loop point (position data only: the cross tangent
+    /// is not a curve on a surface).
+    fn host_normal(&self, at: &[f64]) -> Option<Vec3> {
+        (self.order == 0).then(|| {
+            let (_, ss, sw) = self.frame(at[0], at.get(1).copied().unwrap_or(0.0));
+            ss.cross(sw)
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fast paths equal the jets (to round-off: different evaluation orders).
+    #[test]
+    fn fast_paths_match_the_jets() {
+        let f = crate::data::ExprField::parse(
+            ["cos(w)*(1 + s*s)", "sin(w)*exp(s)", "s*w + 0.3*w*w"],
+            &["s", "w", "t"],
+            &|_| None,
+        )
+        .unwrap();
+        let piece = |w0: f64| Piece {
+            surface: std::sync::Arc::new(f.clone()),
+            s0: 0.2,
+            w0,
+            lambda: 0.7,
+            c: 1.3,
+            start: (0.4, -0.2),
+            end: (0.9, 0.35),
+        };
+        for order in [0, 1] {
+            let d = LoopData { pieces: vec![piece(0.0), piece(1.0), piece(2.0)], order, blend: 0.3 };
+            for v in [0.05, 0.4, 1.0, 2.2, 3.3, 6.1] {
+                let mut fast = [Vec3::ZERO; 4];
+                let n = if order == 0 { 4 } else { 1 };
+                d.derivatives_in(&[v, 0.0], 0, &mut fast[..n]);
+                let mut slow = [Vec3::ZERO; 4];
+                crate::data::derivatives_by_jet(&d, &[v, 0.0], 0, &mut slow[..n]);
+                for k in 0..n {
+                    assert!(
+                        (fast[k] - slow[k]).norm() < 1e-13 * (1.0 + slow[k].norm()),
+                        "{order} {v} {k}: {:?} {:?}",
+                        fast[k],
+                        slow[k]
+                    );
+                }
+                assert!((d.eval(&[v, 0.0]) - slow[0]).norm() < 1e-14 * (1.0 + slow[0].norm()));
+            }
+        }
+    }
 
     #[test]
     fn the_bump_is_one_at_the_corner_zero_beyond_and_c3() {

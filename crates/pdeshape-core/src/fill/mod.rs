@@ -1,5 +1,5 @@
-//! N-sided hole filling with exact G1 to the neighbouring surfaces (issue 21; scene files,
-//! G2 and the examples are still to come).
+//! N-sided hole filling with exact G1 to the neighbouring surfaces (scene `kind = "fill"`;
+//! G2 by a 6th-order operator is still to come).
 //!
 //! A hole bounded by a loop of `N ≥ 3` edges, each an isoline `s = s₀` of a neighbouring
 //! surface `S_k(s, w)` (from `w₀` to `w₁`), is filled by a periodic biharmonic patch
@@ -126,7 +126,8 @@ pub struct EdgeContinuity {
 
 /// A solved N-sided fill.
 pub struct Fill {
-    patch: SpectralPatch,
+    patch: Arc<SpectralPatch>,
+    conditions: Vec<Condition>,
     position: Arc<LoopData>,
     report: FillReport,
     t: f64,
@@ -206,7 +207,9 @@ impl Fill {
             }
             for i in 0..per {
                 let w = e.w.0 + (e.w.1 - e.w.0) * i as f64 / per as f64;
-                pts.push(point_frame(e, w, t).0);
+                let mut p = [Vec3::ZERO];
+                e.surface.derivatives_in(&[e.s0, w, t], 1, &mut p);
+                pts.push(p[0]);
             }
         }
         let centroid = pts.iter().fold(Vec3::ZERO, |a, p| a + *p) * (1.0 / pts.len() as f64);
@@ -298,13 +301,20 @@ impl Fill {
             Condition { u: 1.0, order: 0, data: fixed(pole, 0.0) },
             Condition { u: 1.0, order: 1, data: fixed(Vec3::ZERO, -rho) },
         ];
-        let patch = SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?;
-        Ok(Fill { patch, position, report: FillReport { corner_angles, pole, centroid, radius, normal }, t })
+        let patch = Arc::new(SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?);
+        let report = FillReport { corner_angles, pole, centroid, radius, normal };
+        Ok(Fill { patch, conditions: conds.to_vec(), position, report, t })
     }
 
     /// The fill surface.
-    pub fn patch(&self) -> &SpectralPatch {
+    pub fn patch(&self) -> &Arc<SpectralPatch> {
         &self.patch
+    }
+
+    /// Its four conditions: loop and cross tangent at `u = 0`, pole and ring at `u = 1`.
+    /// The loop's data answer [`Field::host_normal`] with the neighbour's normal.
+    pub fn conditions(&self) -> &[Condition] {
+        &self.conditions
     }
 
     /// What the construction found.

@@ -128,7 +128,7 @@ impl Ctx<'_> {
         Ok(v)
     }
 
-    fn vec3(&self, x: &[NumOrExpr; 3], sp: Option<Range<usize>>, key: &str) -> R<Vec3> {
+    pub(super) fn vec3(&self, x: &[NumOrExpr; 3], sp: Option<Range<usize>>, key: &str) -> R<Vec3> {
         Ok(Vec3::new(self.num(&x[0], sp.clone(), key)?, self.num(&x[1], sp.clone(), key)?, self.num(&x[2], sp, key)?))
     }
 
@@ -736,11 +736,12 @@ fn build_patch(
         "blend" => PatchKind::Blend,
         "dynamic" => PatchKind::Dynamic,
         "solid" => PatchKind::Solid,
+        "fill" => PatchKind::Fill,
         k => {
             return Err(ctx.err(
                 span(&rp.kind),
                 format!("{key}.kind"),
-                format!("unknown patch kind `{k}` (known: hermite, pde, blend, dynamic, solid)"),
+                format!("unknown patch kind `{k}` (known: hermite, pde, blend, dynamic, solid, fill)"),
             ));
         }
     };
@@ -749,7 +750,8 @@ fn build_patch(
         // serve dynamic and solid blends
         let shared = matches!(name, "start" | "end" | "solver" | "collocation" | "basis")
             && matches!(kind, PatchKind::Blend | PatchKind::Dynamic)
-            || matches!(name, "beta" | "gamma") && kind == PatchKind::Solid;
+            || matches!(name, "beta" | "gamma") && kind == PatchKind::Solid
+            || matches!(name, "a" | "modes" | "omega") && kind == PatchKind::Fill;
         if present && kind != for_kind && !shared {
             return Err(ctx.err(
                 span(p),
@@ -797,11 +799,21 @@ fn build_patch(
     ] {
         only(present, name, PatchKind::Solid)?;
     }
-    if rp.trim.is_some() && matches!(kind, PatchKind::Dynamic | PatchKind::Solid) {
+    for (present, name) in [
+        (rp.edges.is_some(), "edges"),
+        (rp.pole.is_some(), "pole"),
+        (rp.height.is_some(), "height"),
+        (rp.ring.is_some(), "ring"),
+        (rp.corner_blend.is_some(), "corner_blend"),
+        (rp.fullness.is_some(), "fullness"),
+    ] {
+        only(present, name, PatchKind::Fill)?;
+    }
+    if rp.trim.is_some() && matches!(kind, PatchKind::Dynamic | PatchKind::Solid | PatchKind::Fill) {
         return Err(ctx.err(
             span(p),
             format!("{key}.trim"),
-            "trims apply to hermite, pde and blend patches (not to moving or solid ones)",
+            "trims apply to hermite, pde and blend patches (not to moving, solid or fill ones)",
         ));
     }
     if kind == PatchKind::Solid {
@@ -815,6 +827,9 @@ fn build_patch(
             }
         }
         return build_solid(ctx, pname, &key, p);
+    }
+    if kind == PatchKind::Fill {
+        return super::fill::build_fill(ctx, pname, &key, p, surfaces);
     }
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;
@@ -973,6 +988,7 @@ fn build_patch(
             Arc::new(f)
         }
         PatchKind::Solid => unreachable!("solid patches are built by build_solid"),
+        PatchKind::Fill => unreachable!("fills are built by fill::build_fill"),
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
     let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, domain, surface.as_ref())).transpose()?;
@@ -989,6 +1005,7 @@ fn build_patch(
         dynamic,
         solid: None,
         trim,
+        fill: None,
     })
 }
 
@@ -1086,6 +1103,7 @@ fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<Sc
         dynamic: None,
         solid: Some(super::SolidSetup { blend, faces, cells, primary }),
         trim: None,
+        fill: None,
     })
 }
 

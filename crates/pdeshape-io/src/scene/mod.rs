@@ -11,6 +11,7 @@
 mod build;
 pub mod edit;
 mod error;
+mod fill;
 mod raw;
 mod trim;
 
@@ -83,6 +84,8 @@ pub enum PatchKind {
     Dynamic,
     /// A volumetric blend between two solids (SPEC §6).
     Solid,
+    /// An N-sided hole filled with exact G1 to its neighbours.
+    Fill,
 }
 
 impl PatchKind {
@@ -94,6 +97,7 @@ impl PatchKind {
             PatchKind::Blend => "blend",
             PatchKind::Dynamic => "dynamic",
             PatchKind::Solid => "solid",
+            PatchKind::Fill => "fill",
         }
     }
 }
@@ -126,6 +130,8 @@ pub struct ScenePatch {
     pub solid: Option<SolidSetup>,
     /// The trim and its meshed region, for trimmed patches.
     pub trim: Option<TrimSetup>,
+    /// Fills: the solved fill (its report, edge continuity, folds).
+    pub fill: Option<Arc<pdeshape_core::fill::Fill>>,
 }
 
 impl ScenePatch {

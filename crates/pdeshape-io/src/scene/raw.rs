@@ -184,10 +184,36 @@ pub struct RawPatch {
     pub frames: Option<Spanned<i64>>,
     /// Trims: closed curves in `(u, v)` whose insides are removed.
     pub trim: Option<Spanned<RawTrim>>,
+    /// Fills: the hole's edges, in loop order.
+    pub edges: Option<Spanned<Vec<Spanned<RawEdge>>>>,
+    /// Fills: the pole (default above the loop's centroid).
+    pub pole: Option<Spanned<[NumOrExpr; 3]>>,
+    /// Fills: factor on the default pole height.
+    pub height: Option<Spanned<NumOrExpr>>,
+    /// Fills: length of the cross tangent at the pole.
+    pub ring: Option<Spanned<NumOrExpr>>,
+    /// Fills: half-width of the corner blends, as a fraction of an edge.
+    pub corner_blend: Option<Spanned<NumOrExpr>>,
+    /// Fills: cross-tangent length relative to the loop's radius, for every edge.
+    pub fullness: Option<Spanned<NumOrExpr>>,
     /// Blends: the primary surface at `u = 0` (conditions of orders 0, 1, 2 from its trimline).
     pub start: Option<Spanned<RawEnd>>,
     /// Blends: the primary surface at `u = 1`.
     pub end: Option<Spanned<RawEnd>>,
+}
+
+/// An edge of a fill's hole: the isoline `s` of a surface, `v` from `w[0]` to `w[1]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawEdge {
+    /// The neighbouring surface (a `[surfaces.NAME]`).
+    pub surface: Spanned<String>,
+    /// The isoline `s = s₀`.
+    pub s: Spanned<NumOrExpr>,
+    /// The surface's `v` at the edge's start and end, in the loop's direction.
+    pub w: Spanned<[NumOrExpr; 2]>,
+    /// This edge's fullness (overrides the patch's).
+    pub fullness: Option<Spanned<NumOrExpr>>,
 }
 
 /// A blend end: a trimline of a primary surface.

@@ -1,0 +1,105 @@
+//! N-sided fills (`kind = "fill"`) through the scene files: the three sphere holes meet the
+//! sphere G1 to round-off along every edge (corners included), without folds, with the
+//! numbers beside OpenCASCADE's plate; bad loops are scene errors naming the place.
+
+use assert_cmd::Command;
+use pdeshape_io::model;
+use pdeshape_io::scene::Scene;
+use std::path::PathBuf;
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
+}
+
+#[test]
+fn sphere_holes_are_filled_with_exact_g1() {
+    for (name, occt_g1) in [("triangle", 2.7e-3), ("pentagon", 2.1e-3), ("hexagon", 4.8e-3)] {
+        let scene = Scene::load(&example(&format!("fill-sphere-{name}.toml"))).unwrap();
+        let p = scene.patch("cap").unwrap();
+        let d = model::patch_diagnostics(p);
+        let f = &d["fill"];
+        // the normal is the cross product of two exactly met conditions (position and cross
+        // tangent, both in the sphere's tangent plane): round-off, a few 1e-16 … 1e-15
+        let (g1, gap) = (f["g1_max_radians"].as_f64().unwrap(), f["gap_max_relative"].as_f64().unwrap());
+        assert!(f["edge_samples"].as_u64().unwrap() >= 1000);
+        assert!(g1 <= 1e-9 && gap <= 1e-12, "{name}: G1 {g1}, gap {gap}");
+        assert_eq!(f["folds"], 0, "{name}");
+        assert_eq!(d["continuity"]["class"], "G1", "{name}: {}", d["continuity"]);
+        assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-13);
+        // an independent look at the G1 claim: the sphere's normal is the position itself
+        let s = p.surface.as_ref();
+        let mut worst: f64 = 0.0;
+        for k in 0..2000 {
+            let v = std::f64::consts::TAU * k as f64 / 2000.0;
+            let dd = s.derivatives(0.0, v, 1, 1);
+            let n = dd[2].cross(dd[1]).normalized().unwrap();
+            let r = dd[0].normalized().unwrap();
+            worst = pdeshape_core::num::max_nan(worst, n.cross(r).norm());
+            assert!((dd[0].norm() - 1.0).abs() < 1e-14, "{name}: the loop is on the sphere");
+        }
+        assert!(worst < 1e-12, "{name}: normal vs radius {worst}");
+        let mut dev: f64 = 0.0;
+        for i in 0..=50 {
+            for j in 0..400 {
+                let x = s.point(i as f64 / 50.0, std::f64::consts::TAU * j as f64 / 400.0);
+                dev = pdeshape_core::num::max_nan(dev, (x.norm() - 1.0).abs());
+            }
+        }
+        eprintln!("fill-sphere-{name}: G1 {g1:.1e} rad (OCCT {occt_g1:.1e}), gap {gap:.1e}, max |r − 1| {dev:.2e}");
+        assert!(dev < 1e-2, "{name}: max |r − 1| = {dev}");
+        // the editor colours the seam: its mesh carries the G1 field, u = 0 is a seam end
+        let m = model::editor_mesh(p, None).unwrap();
+        assert!(m.field("g1_angle").is_some());
+        assert_eq!(model::seam_ends(p), vec![0.0]);
+    }
+}
+
+fn fails(scene: &str, expect: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.path().join("out.obj");
+    let o =
+        Command::cargo_bin("pdeshape").unwrap().arg("build").arg(&path).arg("-o").arg(&out).arg("-q").output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for e in expect {
+        assert!(err.contains(e), "expected `{e}` in\n{err}");
+    }
+    assert!(!out.exists());
+}
+
+/// Open loops, reversed edges, too few edges, unknown surfaces and misplaced keys.
+#[test]
+fn bad_loops_are_errors_with_the_place() {
+    let text = std::fs::read_to_string(example("fill-sphere-pentagon.toml")).unwrap();
+    let edges_start = text.find("edges = [").unwrap();
+    let edges_end = edges_start + text[edges_start..].find("\n]").unwrap() + 2;
+    let edges: Vec<&str> = text[edges_start..edges_end].lines().filter(|l| l.contains("surface")).collect();
+    let with =
+        |list: &[String]| format!("{}edges = [\n{}\n]{}", &text[..edges_start], list.join("\n"), &text[edges_end..]);
+    let own: Vec<String> = edges.iter().map(|s| s.to_string()).collect();
+    // an open loop: the last edge left out
+    fails(&with(&own[..4]), &["patches.cap.edges", "edges 3 and 0 do not meet"]);
+    // two edges: not a hole
+    fails(&with(&own[..2]), &["patches.cap.edges", "at least 3 edges"]);
+    // an edge backwards
+    let mut rev = own.clone();
+    let w = rev[2].split("w = [0, ").nth(1).unwrap().split(']').next().unwrap().to_string();
+    rev[2] = rev[2].replace(&format!("w = [0, {w}]"), &format!("w = [{w}, 0]"));
+    fails(&with(&rev), &["patches.cap.edges", "edge 2 runs the wrong way"]);
+    // an unknown surface, named with its key
+    let mut bad = own.clone();
+    bad[1] = bad[1].replace("edge1", "edge9");
+    fails(&with(&bad), &["patches.cap.edges[1].surface", "unknown surface `edge9`"]);
+    // fill keys elsewhere, conditions on a fill
+    fails(
+        &text.replace("kind = \"fill\"", "kind = \"pde\""),
+        &["patches.cap.edges", "only applies to kind = \"fill\""],
+    );
+    fails(
+        &text.replace("modes = 12", "modes = 12\nconditions = [{ u = 0, point = [0, 0, 0] }]"),
+        &["patches.cap.conditions", "a fill takes `edges` instead of `conditions`"],
+    );
+}
