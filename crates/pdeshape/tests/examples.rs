@@ -41,7 +41,7 @@ fn every_example_builds_and_meets_its_conditions() {
 }
 
 /// The examples of the repository, in file-name order.
-const EXAMPLES: [&str; 24] = [
+const EXAMPLES: [&str; 25] = [
     "blend-cone-cylinder",
     "blend-torus-hyperboloid",
     "bloor-wilson-blend",
@@ -49,6 +49,7 @@ const EXAMPLES: [&str; 24] = [
     "dynamic-elliptic-cylinders",
     "dynamic-linear",
     "dynamic-sine",
+    "fill-box-corner",
     "fill-sphere-hexagon",
     "fill-sphere-pentagon",
     "fill-sphere-triangle",

@@ -54,6 +54,35 @@ fn sphere_holes_are_filled_with_exact_g1() {
     }
 }
 
+/// The vertex blend of a rounded box corner: G1 to all three quarter-cylinder fillets (which
+/// meet G1 at the corners: the box faces), near the ideal sphere octant.
+#[test]
+fn box_corner_is_filled_with_exact_g1_near_the_sphere_octant() {
+    let scene = Scene::load(&example("fill-box-corner.toml")).unwrap();
+    let p = scene.patch("corner").unwrap();
+    let r = scene.params["r"].value;
+    let d = model::patch_diagnostics(p);
+    let f = &d["fill"];
+    let (g1, gap) = (f["g1_max_radians"].as_f64().unwrap(), f["gap_max_relative"].as_f64().unwrap());
+    assert!(g1 <= 1e-9 && gap <= 1e-12, "G1 {g1}, gap {gap}");
+    assert_eq!(f["folds"], 0);
+    for a in f["corner_normal_angles_radians"].as_array().unwrap() {
+        assert!(a.as_f64().unwrap() < 1e-12, "the fillets meet G1 at the corners: {a}");
+    }
+    let c = pdeshape_core::Vec3::new(-r, -r, -r);
+    let mut dev: f64 = 0.0;
+    for i in 0..=50 {
+        for j in 0..300 {
+            let x = p.surface.point(i as f64 / 50.0, std::f64::consts::TAU * j as f64 / 300.0);
+            dev = pdeshape_core::num::max_nan(dev, ((x - c).norm() - r).abs());
+        }
+    }
+    eprintln!(
+        "fill-box-corner: G1 {g1:.1e} rad, gap {gap:.1e}, max deviation from the sphere octant {dev:.2e} (r = {r})"
+    );
+    assert!(dev < 1e-2 * r, "{dev}");
+}
+
 fn fails(scene: &str, expect: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
