@@ -164,7 +164,7 @@ impl Field for LoopData {
             let mut f = 1.0;
             for o in out.iter_mut().skip(1) {
                 f *= p.lambda;
-                *o = *o * f;
+                *o *= f;
             }
         } else if out.len() == 1 {
             let (mut along_s, mut along_w) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2]);
