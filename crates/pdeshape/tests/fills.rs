@@ -2,10 +2,12 @@
 //! sphere G1 to round-off along every edge (corners included), without folds, with the
 //! numbers beside OpenCASCADE's plate; bad loops are scene errors naming the place.
 
-use assert_cmd::Command;
 use pdeshape_io::model;
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
+
+mod common;
+use common::build_fails as fails;
 
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
@@ -81,22 +83,6 @@ fn box_corner_is_filled_with_exact_g1_near_the_sphere_octant() {
         "fill-box-corner: G1 {g1:.1e} rad, gap {gap:.1e}, max deviation from the sphere octant {dev:.2e} (r = {r})"
     );
     assert!(dev < 1e-2 * r, "{dev}");
-}
-
-fn fails(scene: &str, expect: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, scene).unwrap();
-    let out = dir.path().join("out.obj");
-    let o =
-        Command::cargo_bin("pdeshape").unwrap().arg("build").arg(&path).arg("-o").arg(&out).arg("-q").output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for e in expect {
-        assert!(err.contains(e), "expected `{e}` in\n{err}");
-    }
-    assert!(!out.exists());
 }
 
 /// Open loops, reversed edges, too few edges, unknown surfaces and misplaced keys.

@@ -2,11 +2,13 @@
 //! no mesh vertex lies inside a trim curve, the mesh boundary reproduces the trim curve,
 //! the dolphin's fins start on its trimmed body, and bad trims are refused.
 
-use assert_cmd::Command;
 use pdeshape_core::trim::inside_polygon;
 use pdeshape_io::model;
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
+
+mod common;
+use common::build_fails as fails;
 
 fn example(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)
@@ -103,22 +105,6 @@ fn dolphin_fins_start_on_the_body() {
     }
     assert!(scene.patch("flukes").is_some());
     assert!(model::seam_ends(body).is_empty() && model::patch_diagnostics(body)["continuity"].is_null());
-}
-
-fn fails(scene: &str, expect: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, scene).unwrap();
-    let out = dir.path().join("out.obj");
-    let o =
-        Command::cargo_bin("pdeshape").unwrap().arg("build").arg(&path).arg("-o").arg(&out).arg("-q").output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for e in expect {
-        assert!(err.contains(e), "expected `{e}` in\n{err}");
-    }
-    assert!(!out.exists());
 }
 
 const SHEET: &str = r#"

@@ -170,36 +170,17 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::patch::{Surface, VDomain};
+    use crate::patch::Surface;
+    use crate::patch::test_shapes::Sphere;
 
-    /// The unit sphere X = (sin πu cos v, sin πu sin v, cos πu): poles at u = 0 and 1.
-    struct Sphere;
-    impl Surface for Sphere {
-        fn v_domain(&self) -> VDomain {
-            VDomain::PERIODIC
-        }
-        fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
-            let pi = std::f64::consts::PI;
-            let mut out = Vec::new();
-            for i in 0..=du {
-                for j in 0..=dv {
-                    let a = pi.powi(i as i32);
-                    let su = (pi * u + i as f64 * pi / 2.0).sin() * a;
-                    let cu = (pi * u + i as f64 * pi / 2.0).cos() * a;
-                    let cv = (v + j as f64 * pi / 2.0).cos();
-                    let sv = (v + j as f64 * pi / 2.0).sin();
-                    out.push(Vec3::new(su * cv, su * sv, if j == 0 { cu } else { 0.0 }));
-                }
-            }
-            out
-        }
-    }
+    /// The unit sphere: poles at u = 0 and 1.
+    const SPHERE: Sphere = Sphere(1.0);
 
     #[test]
     fn mean_curvature_of_the_unit_sphere_is_one_and_undefined_at_the_poles() {
         let us = [0.0, 0.1, 0.37, 0.5, 0.81];
         let vs = [0.0, 1.0, 2.5, 4.0];
-        let g = Sphere.grid2(&us, &vs);
+        let g = SPHERE.grid2(&us, &vs);
         for (k, j) in g.iter().enumerate() {
             let u = us[k / vs.len()];
             match crate::patch::mean_curvature(j) {
@@ -211,8 +192,8 @@ mod tests {
 
     #[test]
     fn curvature_fields_of_the_unit_sphere() {
-        let mut m = grid_mesh(&Sphere, &GridOptions::new(11, 9)).unwrap();
-        m.add_curvatures(&Sphere, &CurvatureKind::ALL);
+        let mut m = grid_mesh(&SPHERE, &GridOptions::new(11, 9)).unwrap();
+        m.add_curvatures(&SPHERE, &CurvatureKind::ALL);
         let f = |k: CurvatureKind| &m.field(k.field_name()).unwrap().values;
         for (i, uv) in m.uvs.iter().enumerate() {
             let pole = uv[0] == 0.0 || uv[0] == 1.0;
@@ -234,7 +215,7 @@ mod tests {
 
     #[test]
     fn sphere_normals_are_radial_including_poles() {
-        let m = grid_mesh(&Sphere, &GridOptions::new(9, 13)).unwrap();
+        let m = grid_mesh(&SPHERE, &GridOptions::new(9, 13)).unwrap();
         for (p, n) in m.positions.iter().zip(&m.normals) {
             let r = p.normalized().unwrap();
             // X_u × X_v points inwards or outwards consistently; poles included.
@@ -247,8 +228,8 @@ mod tests {
 
     #[test]
     fn grid_bytes_bounds_the_bytes_of_a_grid_mesh() {
-        let mut m = grid_mesh(&Sphere, &GridOptions::new(30, 41)).unwrap();
-        m.add_mean_curvature(&Sphere);
+        let mut m = grid_mesh(&SPHERE, &GridOptions::new(30, 41)).unwrap();
+        m.add_mean_curvature(&SPHERE);
         let (have, bound) = (m.bytes() as u128, Mesh::grid_bytes(30 * 41, 1, 0));
         assert!(have <= bound && have as f64 > 0.95 * bound as f64, "{have} vs {bound}");
     }

@@ -134,30 +134,7 @@ pub fn plane_section(s: &dyn Surface, us: &[f64], vs: &[f64], p: Vec3, a: Vec3) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::patch::VDomain;
-
-    /// The sphere of radius r: X = r (sin πu cos v, sin πu sin v, cos πu).
-    struct Sphere(f64);
-    impl Surface for Sphere {
-        fn v_domain(&self) -> VDomain {
-            VDomain::PERIODIC
-        }
-        fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
-            let pi = std::f64::consts::PI;
-            let mut out = Vec::new();
-            for i in 0..=du {
-                for j in 0..=dv {
-                    let a = self.0 * pi.powi(i as i32);
-                    let su = (pi * u + i as f64 * pi / 2.0).sin() * a;
-                    let cu = (pi * u + i as f64 * pi / 2.0).cos() * a;
-                    let cv = (v + j as f64 * pi / 2.0).cos();
-                    let sv = (v + j as f64 * pi / 2.0).sin();
-                    out.push(Vec3::new(su * cv, su * sv, if j == 0 { cu } else { 0.0 }));
-                }
-            }
-            out
-        }
-    }
+    use crate::patch::test_shapes::Sphere;
 
     /// A latitude circle u = u₀ of the sphere of radius r has radius ρ = r sin πu₀ and its
     /// curvature vector points to the axis: k = −(x, y, 0)/ρ².

@@ -8,6 +8,8 @@ mod curvature;
 mod curves;
 mod hermite;
 mod primary;
+#[cfg(test)]
+pub(crate) mod test_shapes;
 
 pub use curvature::{Curvature, CurvatureKind, curvature};
 pub use curves::{CurvePoint, iso_u_curve, plane_section, section_curvature};

@@ -42,6 +42,28 @@ pub(super) fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
     Some(s.span())
 }
 
+/// The surface `name` refers to; an unknown name is an error at `key` listing the defined
+/// surfaces.
+pub(super) fn find_surface<'s>(
+    ctx: &Ctx,
+    surfaces: &'s [SceneSurface],
+    name: &Spanned<String>,
+    key: &str,
+) -> R<&'s SceneSurface> {
+    surfaces.iter().find(|s| s.name == *name.get_ref()).ok_or_else(|| {
+        let known: Vec<&str> = surfaces.iter().map(|s| s.name.as_str()).collect();
+        ctx.err(
+            span(name),
+            key,
+            format!(
+                "unknown surface `{}` (defined: {})",
+                name.get_ref(),
+                if known.is_empty() { "none".to_string() } else { known.join(", ") }
+            ),
+        )
+    })
+}
+
 fn is_reserved(name: &str) -> bool {
     RESERVED.contains(&name) || Func::from_name(name).is_some()
 }
@@ -554,17 +576,7 @@ impl CurveBuilder<'_, '_> {
             return Ok(Arc::new(Combination::new(fields, constant)));
         }
         if let Some(sname) = &c.surface {
-            let surf = self.surfaces.iter().find(|s| s.name == *sname.get_ref()).ok_or_else(|| {
-                ctx.err(
-                    span(sname),
-                    format!("{key}.surface"),
-                    format!(
-                        "unknown surface `{}` (defined: {})",
-                        sname.get_ref(),
-                        self.surfaces.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
-                    ),
-                )
-            })?;
+            let surf = find_surface(ctx, self.surfaces, sname, &format!("{key}.surface"))?;
             let s = c
                 .s
                 .as_ref()
@@ -850,21 +862,7 @@ fn build_patch(
         let Some(e) = end else { continue };
         let ek = format!("{key}.{name}");
         let re = e.get_ref();
-        let surf = surfaces.iter().find(|s| s.name == *re.surface.get_ref()).ok_or_else(|| {
-            ctx.err(
-                span(&re.surface),
-                format!("{ek}.surface"),
-                format!(
-                    "unknown surface `{}` (defined: {})",
-                    re.surface.get_ref(),
-                    if surfaces.is_empty() {
-                        "none".to_string()
-                    } else {
-                        surfaces.iter().map(|s| s.name.clone()).collect::<Vec<_>>().join(", ")
-                    }
-                ),
-            )
-        })?;
+        let surf = find_surface(ctx, surfaces, &re.surface, &format!("{ek}.surface"))?;
         let s0 = ctx.num(re.s.get_ref(), span(&re.s), &format!("{ek}.s"))?;
         let scale = match &re.scale {
             Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ek}.scale"))?,
@@ -922,9 +920,7 @@ fn build_patch(
             Arc::new(PointField { point: ctx.vec3(x.get_ref(), span(x), &format!("{ck}.point"))?, arity: 1 })
         } else {
             let sname = c.surface.as_ref().expect("counted above");
-            let surf = surfaces.iter().find(|s| s.name == *sname.get_ref()).ok_or_else(|| {
-                ctx.err(span(sname), format!("{ck}.surface"), format!("unknown surface `{}`", sname.get_ref()))
-            })?;
+            let surf = find_surface(ctx, surfaces, sname, &format!("{ck}.surface"))?;
             let s = c.s.as_ref().ok_or_else(|| ctx.err(span(rc), &ck, "a trimline condition needs `s`"))?;
             let s0 = ctx.num(s.get_ref(), span(s), &format!("{ck}.s"))?;
             let scale = match &c.scale {

@@ -1,7 +1,7 @@
 //! `kind = "fill"`: an N-sided hole between `[surfaces.*]` filled with exact G1
 //! (`pdeshape_core::fill`).
 
-use super::build::{Ctx, R, span};
+use super::build::{Ctx, R, find_surface, span};
 use super::raw::{NumOrExpr, RawPatch};
 use super::{PatchKind, ScenePatch, SceneSurface};
 use pdeshape_core::fill::{Fill, FillEdge, FillOptions};
@@ -40,18 +40,7 @@ pub(super) fn build_fill(
     for (i, e) in edges.get_ref().iter().enumerate() {
         let ek = format!("{key}.edges[{i}]");
         let re = e.get_ref();
-        let surf = surfaces.iter().find(|s| s.name == *re.surface.get_ref()).ok_or_else(|| {
-            let known: Vec<String> = surfaces.iter().map(|s| s.name.clone()).collect();
-            ctx.err(
-                span(&re.surface),
-                format!("{ek}.surface"),
-                format!(
-                    "unknown surface `{}` (defined: {})",
-                    re.surface.get_ref(),
-                    if known.is_empty() { "none".into() } else { known.join(", ") }
-                ),
-            )
-        })?;
+        let surf = find_surface(ctx, surfaces, &re.surface, &format!("{ek}.surface"))?;
         let s0 = ctx.num(re.s.get_ref(), span(&re.s), &format!("{ek}.s"))?;
         let [w0, w1] = re.w.get_ref();
         let w = (ctx.num(w0, span(&re.w), &format!("{ek}.w[0]"))?, ctx.num(w1, span(&re.w), &format!("{ek}.w[1]"))?);

@@ -36,3 +36,28 @@ pub fn serve(scene: Option<&str>) -> (Kill, String) {
     assert!(url.starts_with("http://127.0.0.1:"), "serve printed {line:?}");
     (Kill(child), url)
 }
+
+/// `pdeshape build SCENE -o out.obj` on `scene` (a file in a temporary directory) fails with
+/// exit code 1, without a panic, with every string of `expect` in its message, and writes
+/// nothing.
+pub fn build_fails(scene: &str, expect: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.path().join("out.obj");
+    let o = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .arg("build")
+        .arg(&path)
+        .arg("-o")
+        .arg(&out)
+        .arg("-q")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for e in expect {
+        assert!(err.contains(e), "expected `{e}` in\n{err}");
+    }
+    assert!(!out.exists());
+}
