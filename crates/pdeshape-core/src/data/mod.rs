@@ -76,9 +76,12 @@ pub trait Field: Send + Sync + Debug {
     /// slots; extra slots are ignored.
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet;
 
-    /// The value at `at`.
+    /// The value at `at`: through [`derivatives_in`](Self::derivatives_in) (order 0), so a
+    /// field with a fast one-slot path evaluates through it (the default there is the jet).
     fn eval(&self, at: &[f64]) -> Vec3 {
-        self.jet(at, JetShape::scalar()).value()
+        let mut out = [Vec3::ZERO];
+        self.derivatives_in(at, 0, &mut out);
+        out[0]
     }
 
     /// `∂ᵏF/∂(slot)ᵏ` at `at` for `k = 0 … out.len() − 1`, exactly (the other slots held

@@ -59,12 +59,6 @@ impl Field for Trimline {
             Jet::from_coeffs(shape, c)
         }))
     }
-    fn eval(&self, at: &[f64]) -> Vec3 {
-        // the one-slot fast path (a compiled tape in Taylor series), not a full jet
-        let mut out = [Vec3::ZERO];
-        self.derivatives_in(at, 0, &mut out);
-        out[0]
-    }
     fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
         let t = at.get(1).copied().unwrap_or(0.0);
         let on_surface = [self.s0, at[0], t];

@@ -141,11 +141,6 @@ impl Field for LoopData {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot == 1
     }
-    fn eval(&self, at: &[f64]) -> Vec3 {
-        let mut out = [Vec3::ZERO];
-        self.derivatives_in(at, 0, &mut out);
-        out[0]
-    }
     /// The fast paths (the neighbours' compiled one-slot derivatives, no jets): positions
     /// to any order along `v` (`dʲ/dvʲ S(s₀, w(v)) = λʲ ∂ʲS/∂wʲ`), the cross tangent's value
     /// (`α S_s + β S_w` from one derivative along `s` and one along `w`); the rest through

@@ -26,6 +26,18 @@ fn sphere_hole(n: usize, theta: f64) -> Vec<FillEdge> {
         .collect()
 }
 
+/// The largest |r − 1| of the fill on a 41 × 200 grid (NaN-propagating).
+fn sphere_deviation(s: &SpectralPatch) -> f64 {
+    let mut dev: f64 = 0.0;
+    for i in 0..=40 {
+        for j in 0..200 {
+            let p = s.point(i as f64 / 40.0, TAU * j as f64 / 200.0);
+            dev = crate::num::max_nan(dev, (p.norm() - 1.0).abs());
+        }
+    }
+    dev
+}
+
 /// The three sphere holes: G1 to round-off along every edge (corners included),
 /// no gap, no fold; the deviation from the sphere inside printed beside OCCT's figures.
 #[test]
@@ -41,13 +53,7 @@ fn sphere_holes_are_filled_with_exact_g1() {
         assert!(fill.report().corner_angles.iter().all(|a| *a < 1e-12), "{:?}", fill.report().corner_angles);
         assert_eq!(fill.folds(41, 200), 0, "{n}-gon folds");
         let s = fill.patch();
-        let mut dev: f64 = 0.0;
-        for i in 0..=40 {
-            for j in 0..200 {
-                let p = s.point(i as f64 / 40.0, TAU * j as f64 / 200.0);
-                dev = crate::num::max_nan(dev, (p.norm() - 1.0).abs());
-            }
-        }
+        let dev = sphere_deviation(s);
         eprintln!(
             "{n} sides, θ = {deg}°: G1 {:.1e} rad, gap {:.1e}, max |r − 1| {dev:.2e}, pole {:?}",
             c.g1,
@@ -95,13 +101,7 @@ fn sphere_fill_parameter_scan() {
                     };
                     let fill = Fill::new(&e, &o).unwrap();
                     let s = fill.patch();
-                    let mut dev: f64 = 0.0;
-                    for i in 0..=40 {
-                        for j in 0..200 {
-                            let p = s.point(i as f64 / 40.0, TAU * j as f64 / 200.0);
-                            dev = crate::num::max_nan(dev, (p.norm() - 1.0).abs());
-                        }
-                    }
+                    let dev = sphere_deviation(s);
                     eprintln!("{n} {deg} full {full} ring {ring} a {a}: {dev:.2e} folds {}", fill.folds(21, 100));
                 }
             }
