@@ -870,16 +870,29 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             "edge_samples": e.samples,
             "g1_max_radians": e.g1,
             "gap_max_relative": e.gap,
+            "g2_max_relative": e.g2,
+            "order": f.patch().order(),
             "corner_normal_angles_radians": r.corner_angles,
             "folds": f.folds(41, 400),
             "pole": [r.pole.x, r.pole.y, r.pole.z],
             "loop_radius": r.radius,
         });
+        if let Some(k) = r.pole_curvature {
+            d["fill"]["pole_curvature"] = json!(k);
+            d["fill"]["corner_curvature_gaps_relative"] = json!(r.corner_curvature_gaps);
+        }
         if let Some(w) = d["warnings"].as_array_mut() {
             for (k, a) in r.corner_angles.iter().enumerate() {
                 if a.is_nan() || *a > 1e-9 {
                     w.push(json!(format!(
                         "corner {k}: the neighbours' tangent planes differ by {a:.2e} rad there, so no surface meets both G1 at that corner"
+                    )));
+                }
+            }
+            for (k, g) in r.corner_curvature_gaps.iter().enumerate() {
+                if g.is_nan() || *g > 1e-8 {
+                    w.push(json!(format!(
+                        "corner {k}: the neighbours' normal curvatures across the corner differ by {g:.2e} (relative), so no surface meets both G2 there; G2 is given up within that corner's blend"
                     )));
                 }
             }

@@ -591,11 +591,13 @@ fn print_check(sc: &Scene, d: &serde_json::Value) {
         let f = &p["fill"];
         if f.is_object() {
             println!(
-                "      fill: {} edges, {} points: G1 angle ≤ {:.1e} rad, gap ≤ {:.1e} (relative); folds {}; pole {}",
+                "      fill (order {}): {} edges, {} points: G1 angle ≤ {:.1e} rad, gap ≤ {:.1e}, curvature gap ≤ {:.1e} (relative); folds {}; pole {}",
+                f["order"],
                 f["edges"],
                 f["edge_samples"],
                 f["g1_max_radians"].as_f64().unwrap_or(f64::NAN),
                 f["gap_max_relative"].as_f64().unwrap_or(f64::NAN),
+                f["g2_max_relative"].as_f64().unwrap_or(f64::NAN),
                 f["folds"],
                 f["pole"],
             );

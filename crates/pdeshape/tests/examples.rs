@@ -41,7 +41,7 @@ fn every_example_builds_and_meets_its_conditions() {
 }
 
 /// The examples of the repository, in file-name order.
-const EXAMPLES: [&str; 25] = [
+const EXAMPLES: [&str; 26] = [
     "blend-cone-cylinder",
     "blend-torus-hyperboloid",
     "bloor-wilson-blend",
@@ -53,6 +53,7 @@ const EXAMPLES: [&str; 25] = [
     "fill-sphere-hexagon",
     "fill-sphere-pentagon",
     "fill-sphere-triangle",
+    "fill-wing-root",
     "four-curve-patch",
     "hermite-blend",
     "hermite-pole",

@@ -119,6 +119,7 @@ every_example! {
     fill_sphere_hexagon => "fill-sphere-hexagon.toml",
     fill_sphere_pentagon => "fill-sphere-pentagon.toml",
     fill_sphere_triangle => "fill-sphere-triangle.toml",
+    fill_wing_root => "fill-wing-root.toml",
     four_curve_patch => "four-curve-patch.toml",
     hermite_blend => "hermite-blend.toml",
     hermite_pole => "hermite-pole.toml",

@@ -21,6 +21,11 @@ pub(crate) struct Piece {
     /// At the start corner: `T_c = a S_s + b S_w` there; likewise at the end corner.
     pub start: (f64, f64),
     pub end: (f64, f64),
+    /// Second cross derivative (order 2 only): the corrections `γ S_s + δ S_w + η N` that
+    /// make it continuous at the start and end corners (`N = S_s × S_w`), faded by the
+    /// same bumps as the cross tangent's weights.
+    pub start2: [f64; 3],
+    pub end2: [f64; 3],
 }
 
 /// `1 − (35x⁴ − 84x⁵ + 70x⁶ − 20x⁷)` on `[0, 1]`, 0 beyond: 1 at the corner, 0 at the
@@ -47,13 +52,28 @@ fn bump(x: f64, slope: f64, order: usize) -> Vec<f64> {
     out
 }
 
+fn add(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x + y).collect()
+}
+
+fn sub(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x - y).collect()
+}
+
+/// `[S, S_s, S_w, S_ss, S_sw, S_ww]` of `surface` at `(s, w, t)`.
+pub(crate) fn second_frame(surface: &FieldRef, s: f64, w: f64, t: f64) -> [Vec3; 6] {
+    let j = surface.jet(&[s, w, t], JetShape::new(&[2, 2, 0]));
+    let g = |m: [usize; 3], f: f64| Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m)) * f;
+    [g([0, 0, 0], 1.0), g([1, 0, 0], 1.0), g([0, 1, 0], 1.0), g([2, 0, 0], 2.0), g([1, 1, 0], 1.0), g([0, 2, 0], 2.0)]
+}
+
 /// Cauchy product of truncated series.
 fn mul(a: &[f64], b: &[f64]) -> Vec<f64> {
     let n = a.len().min(b.len());
     (0..n).map(|k| (0..=k).map(|i| a[i] * b[k - i]).sum()).collect()
 }
 
-/// The loop data: `order` 0 (position) or 1 (cross tangent).
+/// The loop data: `order` 0 (position), 1 (cross tangent) or 2 (second cross derivative).
 #[derive(Clone, Debug)]
 pub(crate) struct LoopData {
     pub pieces: Vec<Piece>,
@@ -78,8 +98,9 @@ impl LoopData {
         let (k, dv) = self.locate(v);
         let p = &self.pieces[k];
         let w = p.w0 + p.lambda * dv;
-        let sj = p.surface.jet(&[p.s0, w, t], JetShape::new(&[1, order + 1, 0]));
-        let lam_pow: Vec<f64> = (0..=order + 1).map(|j| p.lambda.powi(j as i32)).collect();
+        let ds = self.order.max(1);
+        let sj = p.surface.jet(&[p.s0, w, t], JetShape::new(&[ds, order + ds, 0]));
+        let lam_pow: Vec<f64> = (0..=order + ds).map(|j| p.lambda.powi(j as i32)).collect();
         if self.order == 0 {
             return std::array::from_fn(|c| (0..=order).map(|j| sj.0[c].coeff([0, j, 0]) * lam_pow[j]).collect());
         }
@@ -95,14 +116,35 @@ impl LoopData {
             })
             .collect();
         let beta: Vec<f64> = (0..=order).map(|j| ws[j] * p.start.1 + we[j] * p.end.1).collect();
+        // S_s(s0, w(v)) and S_w(s0, w(v)) as series in v
+        let ss: [Vec<f64>; 3] =
+            std::array::from_fn(|c| (0..=order).map(|j| sj.0[c].coeff([1, j, 0]) * lam_pow[j]).collect());
+        let sw: [Vec<f64>; 3] = std::array::from_fn(|c| {
+            (0..=order).map(|j| (j + 1) as f64 * sj.0[c].coeff([0, j + 1, 0]) * lam_pow[j]).collect()
+        });
+        if self.order == 1 {
+            return std::array::from_fn(|c| add(&mul(&alpha, &ss[c]), &mul(&beta, &sw[c])));
+        }
+        // Q = α² S_ss + 2αβ S_sw + β² S_ww + ω_s (γ S_s + δ S_w + η N)_s + ω_e (…)_e
+        let aa = mul(&alpha, &alpha);
+        let ab: Vec<f64> = mul(&alpha, &beta).iter().map(|x| 2.0 * x).collect();
+        let bb = mul(&beta, &beta);
+        let n: [Vec<f64>; 3] = std::array::from_fn(|c| {
+            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+            sub(&mul(&ss[c1], &sw[c2]), &mul(&ss[c2], &sw[c1]))
+        });
         std::array::from_fn(|c| {
-            // S_s(s0, w(v)) and S_w(s0, w(v)) as series in v
-            let ss: Vec<f64> = (0..=order).map(|j| sj.0[c].coeff([1, j, 0]) * lam_pow[j]).collect();
-            let sw: Vec<f64> =
-                (0..=order).map(|j| (j + 1) as f64 * sj.0[c].coeff([0, j + 1, 0]) * lam_pow[j]).collect();
-            let a = mul(&alpha, &ss);
-            let b = mul(&beta, &sw);
-            a.iter().zip(&b).map(|(x, y)| x + y).collect()
+            let sss: Vec<f64> = (0..=order).map(|j| 2.0 * sj.0[c].coeff([2, j, 0]) * lam_pow[j]).collect();
+            let ssw: Vec<f64> =
+                (0..=order).map(|j| (j + 1) as f64 * sj.0[c].coeff([1, j + 1, 0]) * lam_pow[j]).collect();
+            let sww: Vec<f64> =
+                (0..=order).map(|j| ((j + 1) * (j + 2)) as f64 * sj.0[c].coeff([0, j + 2, 0]) * lam_pow[j]).collect();
+            let mut q = add(&add(&mul(&aa, &sss), &mul(&ab, &ssw)), &mul(&bb, &sww));
+            for (w, [g, d, e]) in [(&ws, p.start2), (&we, p.end2)] {
+                let corr: Vec<f64> = (0..=order).map(|j| g * ss[c][j] + d * sw[c][j] + e * n[c][j]).collect();
+                q = add(&q, &mul(w, &corr));
+            }
+            q
         })
     }
 
@@ -112,6 +154,13 @@ impl LoopData {
         let h = self.blend * span;
         let (ws, we) = (bump(dv / h, 1.0, 0)[0], bump((span - dv) / h, 1.0, 0)[0]);
         ((1.0 - ws - we) * p.c + ws * p.start.0 + we * p.end.0, ws * p.start.1 + we * p.end.1)
+    }
+
+    /// The neighbour's `[S, S_s, S_w, S_ss, S_sw, S_ww]` at the loop's `v` (for diagnostics).
+    pub fn frame2(&self, v: f64, t: f64) -> [Vec3; 6] {
+        let (k, dv) = self.locate(v);
+        let p = &self.pieces[k];
+        second_frame(&p.surface, p.s0, p.w0 + p.lambda * dv, t)
     }
 
     /// The neighbour's point, `S_s` and `S_w` at the loop's `v` (for diagnostics).
@@ -161,7 +210,7 @@ impl Field for LoopData {
                 f *= p.lambda;
                 *o *= f;
             }
-        } else if out.len() == 1 {
+        } else if self.order == 1 && out.len() == 1 {
             let (mut along_s, mut along_w) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2]);
             p.surface.derivatives_in(&on, 0, &mut along_s);
             p.surface.derivatives_in(&on, 1, &mut along_w);
@@ -202,6 +251,8 @@ mod tests {
             c: 1.3,
             start: (0.4, -0.2),
             end: (0.9, 0.35),
+            start2: [0.3, -0.1, 0.2],
+            end2: [-0.2, 0.4, 0.1],
         };
         for order in [0, 1] {
             let d = LoopData { pieces: vec![piece(0.0), piece(1.0), piece(2.0)], order, blend: 0.3 };
@@ -221,6 +272,73 @@ mod tests {
                 }
                 assert!((d.eval(&[v, 0.0]) - slow[0]).norm() < 1e-14 * (1.0 + slow[0].norm()));
             }
+        }
+    }
+
+    /// The series are Taylor series: at `v + h` (same piece, same side of the bumps' ends)
+    /// the truncated series from `v` predicts the value to `O(h⁷)`; and the order-2 value
+    /// is `α² S_ss + 2αβ S_sw + β² S_ww + ω (γ S_s + δ S_w + η S_s × S_w)` written out.
+    #[test]
+    fn the_series_are_taylor_series_of_the_data() {
+        let f = crate::data::ExprField::parse(
+            ["cos(w)*(1 + s*s)", "sin(w)*exp(s)", "s*w + 0.3*w*w*s"],
+            &["s", "w", "t"],
+            &|_| None,
+        )
+        .unwrap();
+        let piece = |w0: f64| Piece {
+            surface: std::sync::Arc::new(f.clone()),
+            s0: 0.2,
+            w0,
+            lambda: 0.7,
+            c: 1.3,
+            start: (0.4, -0.2),
+            end: (0.9, 0.35),
+            start2: [0.3, -0.1, 0.2],
+            end2: [-0.2, 0.4, 0.1],
+        };
+        let span = TAU / 3.0;
+        for order in [0, 1, 2] {
+            let d = LoopData { pieces: vec![piece(0.0), piece(1.0), piece(2.0)], order, blend: 0.3 };
+            // inside the start bump, between the bumps, inside the end bump
+            for v in [0.1 * span, 0.5 * span, 0.9 * span, span + 0.12] {
+                let s = d.series(v, 0.0, 6);
+                let err = |h: f64, c: usize| {
+                    let exact = d.series(v + h, 0.0, 0);
+                    s[c].iter().rev().fold(0.0, |acc, x| acc * h + x) - exact[c][0]
+                };
+                for c in 0..3 {
+                    // the remainder is O(h⁷): halving h divides it by ~128; a wrong k-th
+                    // coefficient (k ≤ 6) would divide it by 2ᵏ ≤ 64 (1e-14: round-off)
+                    let (e1, e2) = (err(0.01, c), err(0.005, c));
+                    assert!(e1.abs() < 1e-10, "{order} {v} {c}: {e1}");
+                    assert!(e2.abs() < e1.abs() / 90.0 + 1e-14, "{order} {v} {c}: {e1} {e2}");
+                }
+            }
+        }
+        // the order-2 value, written out (between the bumps: α = c, β = 0, no correction)
+        let d = LoopData { pieces: vec![piece(0.0), piece(1.0), piece(2.0)], order: 2, blend: 0.3 };
+        let v = 0.5 * span;
+        let (s, w) = (0.2_f64, 0.7 * v);
+        let sss = Vec3::new(2.0 * w.cos(), w.sin() * s.exp(), 0.0);
+        let q = sss * (1.3 * 1.3);
+        let got = d.series(v, 0.0, 0);
+        for c in 0..3 {
+            assert!((got[c][0] - [q.x, q.y, q.z][c]).abs() < 1e-14, "{c}: {} vs {:?}", got[c][0], q);
+        }
+        // at the start corner the bump is 1: α = a, β = b and the full correction
+        let v = 0.0;
+        let w = 0.0_f64;
+        let ss = Vec3::new(w.cos() * 2.0 * s, w.sin() * s.exp(), w + 0.3 * w * w);
+        let sw = Vec3::new(-w.sin() * (1.0 + s * s), w.cos() * s.exp(), s + 0.6 * w * s);
+        let sss = Vec3::new(2.0 * w.cos(), w.sin() * s.exp(), 0.0);
+        let ssw = Vec3::new(-w.sin() * 2.0 * s, w.cos() * s.exp(), 1.0 + 0.6 * w);
+        let sww = Vec3::new(-w.cos() * (1.0 + s * s), -w.sin() * s.exp(), 0.6 * s);
+        let (a, b) = (0.4, -0.2);
+        let q = sss * (a * a) + ssw * (2.0 * a * b) + sww * (b * b) + ss * 0.3 + sw * -0.1 + ss.cross(sw) * 0.2;
+        let got = d.series(v, 0.0, 0);
+        for c in 0..3 {
+            assert!((got[c][0] - [q.x, q.y, q.z][c]).abs() < 1e-14, "{c}: {} vs {:?}", got[c][0], q);
         }
     }
 

@@ -1,9 +1,9 @@
-//! N-sided hole filling with exact G1 to the neighbouring surfaces (scene `kind = "fill"`;
-//! G2 by a 6th-order operator is still to come).
+//! N-sided hole filling with exact G1 (order 4) or G2 (order 6) to the neighbouring
+//! surfaces (scene `kind = "fill"`).
 //!
 //! A hole bounded by a loop of `N ≥ 3` edges, each an isoline `s = s₀` of a neighbouring
-//! surface `S_k(s, w)` (from `w₀` to `w₁`), is filled by a periodic biharmonic patch
-//! `X(u, v)` ([`SpectralPatch`], order 4) whose `u = 0` trimline is the loop — edge `k`
+//! surface `S_k(s, w)` (from `w₀` to `w₁`), is filled by a periodic PDE patch `X(u, v)`
+//! ([`SpectralPatch`], order 4 or 6) whose `u = 0` trimline is the loop — edge `k`
 //! traversed by `v ∈ [2πk/N, 2π(k+1)/N]` — and which closes at `u = 1` in a pole.
 //!
 //! **G1 by construction.** At `u = 0` the conditions are `X = S_k(s₀, w(v))` and
@@ -11,6 +11,13 @@
 //! `S_w`). The patch meets its conditions exactly (the remainder), so `X_v = λ S_w` and
 //! `X_u = T` both lie in the neighbour's tangent plane and the normal `X_u × X_v` is the
 //! neighbour's, for every `v`, to round-off — as long as `T` is not parallel to the edge.
+//!
+//! **G2 by construction (order 6).** With `T = α S_s + β S_w`, the third condition is
+//! `X_uu = Q = α² S_ss + 2αβ S_sw + β² S_ww`, the second derivative of the neighbour's curve
+//! `u ↦ S(s₀ + αu, w + βu)`. Then the fill's second fundamental form equals the
+//! neighbour's: `II(X_u, X_u) = Q·n` is the neighbour's `II(T, T)`; `II(X_v, X_v) = X_vv·n`
+//! and `II(X_u, X_v) = ∂_v T·n = λ(α S_sw + β S_ww)·n` are the neighbour's because `X` and
+//! `X_u` equal its data along the whole edge (tangential parts of `Q` do not enter).
 //!
 //! **Corners.** Along edge `k`, away from its ends, `T = c_k S_s` (`c_k` scales it to
 //! `fullness × R`, `R` the loop's mean radius, and orients it into the hole). At a corner
@@ -23,13 +30,24 @@
 //! everywhere (G1 exact along the whole edge) and equals `T_c` at the corner from both
 //! sides (the patch stays continuous). Neighbours that do not meet G1 at a corner cannot
 //! be matched there by any surface; the mismatch is reported ([`FillReport::corner_angles`]).
+//! At order 6 the two sides' `Q` differ at a corner in their tangential parts (different
+//! parametrisations) and, unless the neighbours meet G2 there, in their normal parts; each
+//! edge adds `ω(v) (γ S_s + δ S_w + η S_s × S_w)` with the same bump `ω` and constant
+//! `(γ, δ, η)` solved at the corner so that both sides reach the mean `Q_c`. The tangential
+//! terms leave G2 untouched; `η` is zero when the neighbours meet G2 at the corner and is
+//! otherwise reported ([`FillReport::corner_curvature_gaps`]): G2 is then given up within
+//! that corner's blend only.
 //!
-//! **Pole.** `X(1, v) = P`, `X_u(1, v) = −ρ (cos v e₁ + sin v e₂)`: near the pole
-//! `X ≈ P + (1 − u) ρ (cos v e₁ + sin v e₂)`, a disc in the plane ⊥ `n̄`, where `n̄` is the
-//! loop's vector-area normal (so the loop and the ring wind the same way) and `e₁` points
-//! to the loop's `v = 0` point. By default `P` lies above the loop's centroid by the height
-//! of the parabolic profile that leaves the edges at their mean slope `tan φ` and is flat at
-//! the centre, `H = R tan φ / 2` (times `height`), and `ρ = R` × the mean fullness.
+//! **Pole.** `X(1, v) = P`, `X_u(1, v) = −ρ (cos v e₁ + sin v e₂)` and at order 6
+//! `X_uu(1, v) = σ n̄`: near the pole `X ≈ P + r ρ (cos v e₁ + sin v e₂) + ½ r² σ n̄`
+//! (`r = 1 − u`), a cap of normal curvature `σ/ρ²` perpendicular to `n̄`, the loop's
+//! vector-area normal (so the loop and the ring wind the same way); `e₁` points to the
+//! loop's `v = 0` point. What the user does not set among `P`, `ρ`, `σ` is chosen by
+//! **least bending**: the fill is linear in them, and they minimise
+//! `∫∫ |X_rr + X_r/r + X_θθ/r²|² r dr dθ` — the thin-plate energy of `X` as a map of the
+//! unit disc (`r = 1 − u`, `θ = v`), whose Laplacian has no singular terms at a smooth
+//! pole — by linear least squares (see [`FillOptions`]). `height` scales the chosen pole's
+//! offset from the loop's centroid.
 
 mod data;
 
@@ -38,7 +56,7 @@ use crate::data::{Field, FieldRef, VecJet};
 use crate::jet::{Jet, JetShape};
 use crate::patch::{Condition, Surface, VDomain};
 use crate::spectral::{SpectralError, SpectralOptions, SpectralPatch};
-use data::{LoopData, Piece};
+use data::{LoopData, Piece, second_frame};
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
@@ -61,14 +79,21 @@ pub struct FillEdge {
 pub struct FillOptions {
     /// Half-width of each corner's blend as a fraction of an edge (0 < · ≤ ½).
     pub corner_blend: f64,
-    /// The pole; default: above the centroid (see the module).
+    /// The pole; default: least bending (see the module).
     pub pole: Option<Vec3>,
-    /// Factor on the default pole height.
+    /// Factor on the default pole's offset from the loop's centroid.
     pub height: f64,
-    /// `ρ`, the length of `X_u` at the pole; default `R` × mean fullness.
+    /// `ρ`, the length of `X_u` at the pole; default: least bending (but `R` × mean
+    /// fullness when `pole_curvature` is set, which makes `σ = κρ²` depend on it).
     pub ring: Option<f64>,
     /// Time at which the neighbours are taken.
     pub t: f64,
+    /// PDE order: 4 (G1: position and cross tangent at the loop) or 6 (G2: also the
+    /// second cross derivative).
+    pub order: usize,
+    /// Order 6: the normal curvature `κ` of the cap at the pole against `n̄`
+    /// (`X_uu(1, v) = κ ρ² n̄`); default: least bending.
+    pub pole_curvature: Option<f64>,
     /// The PDE solve.
     pub spectral: SpectralOptions,
 }
@@ -81,6 +106,8 @@ impl Default for FillOptions {
             height: 1.0,
             ring: None,
             t: 0.0,
+            order: 4,
+            pole_curvature: None,
             spectral: SpectralOptions { a: 1.0, modes: 12, omega: None },
         }
     }
@@ -111,6 +138,14 @@ pub struct FillReport {
     pub radius: f64,
     /// Unit normal of the loop's vector area.
     pub normal: Vec3,
+    /// Order 6: at each corner, the two neighbours' normal curvatures in the corner's cross
+    /// direction differ by this (times the loop's mean radius): 0 when they meet G2 there.
+    /// Where it is not 0 no surface meets both G2 at the corner, and the second cross
+    /// derivative is made continuous by a normal correction that fades within the corner
+    /// blend (G2 holds along the rest of both edges).
+    pub corner_curvature_gaps: Vec<f64>,
+    /// Order 6: the cap's normal curvature at the pole.
+    pub pole_curvature: Option<f64>,
 }
 
 /// Continuity along the edges.
@@ -120,6 +155,10 @@ pub struct EdgeContinuity {
     pub g1: f64,
     /// Largest `|X(0, v) − S|` divided by the loop's mean radius.
     pub gap: f64,
+    /// Largest difference of the normal curvatures of the fill and the neighbour over all
+    /// tangent directions (the spectral norm of the difference of their second fundamental
+    /// forms in a common orthonormal tangent basis), times the loop's mean radius: 0 for G2.
+    pub g2: f64,
     /// Points sampled.
     pub samples: usize,
 }
@@ -183,8 +222,127 @@ fn in_frame(x: Vec3, y: Vec3, z: Vec3) -> (f64, f64) {
     ((yy * xz - xy * yz) / det, (xx * yz - xy * xz) / det)
 }
 
+/// `(γ, δ, η)` with `γ x + δ y + η z = r` (Cramer's rule; `x, y, z` independent).
+fn in_frame3(x: Vec3, y: Vec3, z: Vec3, r: Vec3) -> [f64; 3] {
+    let det = x.dot(y.cross(z));
+    [r.dot(y.cross(z)) / det, x.dot(r.cross(z)) / det, x.dot(y.cross(r)) / det]
+}
+
+/// `d²/du² S(s₀ + a u, w + b u)` at `u = 0` from `[S, S_s, S_w, S_ss, S_sw, S_ww]`.
+fn second(f: &[Vec3; 6], (a, b): (f64, f64)) -> Vec3 {
+    f[3] * (a * a) + f[4] * (2.0 * a * b) + f[5] * (b * b)
+}
+
+/// The second fundamental form `[[L, M], [M, N]]` of a surface with tangents `xu`, `xv`
+/// and second derivatives `xuu`, `xuv`, `xvv`, against the unit normal `n`, written in the
+/// orthonormal tangent basis `(e1, e2)`.
+fn second_form_in(d: [Vec3; 5], n: Vec3, e1: Vec3, e2: Vec3) -> [[f64; 2]; 2] {
+    let [xu, xv, xuu, xuv, xvv] = d;
+    let (ee, ff, gg) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
+    let det = ee * gg - ff * ff;
+    // e = p X_u + q X_v from the metric
+    let coords = |e: Vec3| {
+        let (a, b) = (e.dot(xu), e.dot(xv));
+        ((gg * a - ff * b) / det, (ee * b - ff * a) / det)
+    };
+    let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
+    let form = |x: (f64, f64), y: (f64, f64)| l * x.0 * y.0 + m * (x.0 * y.1 + x.1 * y.0) + nn * x.1 * y.1;
+    let (c1, c2) = (coords(e1), coords(e2));
+    let b12 = form(c1, c2);
+    [[form(c1, c1), b12], [b12, form(c2, c2)]]
+}
+
+/// The spectral norm of a symmetric 2 × 2 matrix (NaN-propagating).
+fn sym_norm(m: [[f64; 2]; 2]) -> f64 {
+    let mean = 0.5 * (m[0][0] + m[1][1]);
+    let half = 0.5 * (m[0][0] - m[1][1]);
+    mean.abs() + (half * half + m[0][1] * m[0][1]).sqrt()
+}
+
 fn line_angle(a: Vec3, b: Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b).abs())
+}
+
+/// The pole's data: position `P`, ring length `ρ`, and (order 6) `σ` in `X_uu = σ n̄`;
+/// as flags, which of them are free.
+#[derive(Clone, Copy, Debug)]
+struct PoleData<T = f64, P = Vec3> {
+    pole: P,
+    ring: T,
+    sigma: T,
+}
+
+/// The pole data of least bending: the fill depends linearly on the pole's data,
+/// `X = X₀ + Σᵢ xᵢ Bᵢ` (`X₀` with the free data at 0, `Bᵢ` the patch with zero loop data and
+/// only datum `i` at 1), so `E = ∫₀¹∫₀^{2π} |L X|² dv du` with `L = ∂u² + a²∂v²` — the
+/// energy a biharmonic patch minimises for given boundary data — is least at the solution
+/// of a linear least-squares problem in the free data (midpoint rule, 32 × 64 points;
+/// the v-rule is exact for the products of the modes).
+fn least_bending(
+    loop_conds: &[Condition],
+    fixed_data: &PoleData,
+    free: &PoleData<bool, bool>,
+    with_pole: &dyn Fn(&PoleData, &[Condition]) -> Vec<Condition>,
+    o: &FillOptions,
+    edges: usize,
+) -> Result<PoleData, FillError> {
+    // a multiple of the edge count in v, so that the rule keeps the loop's symmetries
+    let (nu, nv) = (32, edges * 64usize.div_ceil(edges));
+    let us: Vec<f64> = (0..nu).map(|i| (i as f64 + 0.5) / nu as f64).collect();
+    let vs: Vec<f64> = (0..nv).map(|j| TAU * j as f64 / nv as f64).collect();
+    let energy_rows = |c: &[Condition]| -> Result<Vec<Vec3>, FillError> {
+        let p = SpectralPatch::new(c, VDomain::PERIODIC, o.spectral)?;
+        Ok(p.grid2(&us, &vs)
+            .iter()
+            .enumerate()
+            .map(|(k, d)| {
+                let r = 1.0 - us[k / nv];
+                (d[3] - d[1] * (1.0 / r) + d[5] * (1.0 / (r * r))) * r.sqrt()
+            })
+            .collect())
+    };
+    let zero_loop: Vec<Condition> = loop_conds
+        .iter()
+        .map(|c| Condition {
+            u: c.u,
+            order: c.order,
+            data: Arc::new(Ring { centre: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, rho: 0.0 }),
+        })
+        .collect();
+    let zero = PoleData { pole: Vec3::ZERO, ring: 0.0, sigma: 0.0 };
+    let mut unit: Vec<PoleData> = Vec::new();
+    if free.pole {
+        for e in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.0, 1.0)] {
+            unit.push(PoleData { pole: e, ..zero });
+        }
+    }
+    if free.ring {
+        unit.push(PoleData { ring: 1.0, ..zero });
+    }
+    if free.sigma {
+        unit.push(PoleData { sigma: 1.0, ..zero });
+    }
+    let base = energy_rows(&with_pole(fixed_data, loop_conds))?;
+    let cols: Vec<Vec<Vec3>> = unit.iter().map(|d| energy_rows(&with_pole(d, &zero_loop))).collect::<Result<_, _>>()?;
+    let rows = base.len() * 3;
+    let a = faer::Mat::<f64>::from_fn(rows, cols.len(), |r, c| cols[c][r / 3][r % 3]);
+    let b = faer::Mat::<f64>::from_fn(rows, 1, |r, _| -base[r / 3][r % 3]);
+    let (x, _cond) = crate::linalg::least_squares(&a, &b, 1e12)
+        .map_err(|e| FillError::Loop(format!("the least-bending pole could not be found: {e}")))?;
+    let mut out = *fixed_data;
+    let mut k = 0;
+    if free.pole {
+        out.pole = Vec3::new(x[(0, 0)], x[(1, 0)], x[(2, 0)]);
+        k = 3;
+    }
+    if free.ring {
+        out.ring = x[(k, 0)];
+        k += 1;
+    }
+    if free.sigma {
+        out.sigma = x[(k, 0)];
+    }
+    Ok(out)
 }
 
 impl Fill {
@@ -196,6 +354,12 @@ impl Fill {
         }
         if !(o.corner_blend > 0.0 && o.corner_blend <= 0.5) {
             return Err(FillError::Loop(format!("corner_blend = {} must be in (0, 0.5]", o.corner_blend)));
+        }
+        if o.order != 4 && o.order != 6 {
+            return Err(FillError::Loop(format!("a fill's order is 4 (G1) or 6 (G2), not {}", o.order)));
+        }
+        if let Some(k) = o.pole_curvature.filter(|k| !k.is_finite()) {
+            return Err(FillError::Loop(format!("pole_curvature = {k} must be finite")));
         }
         let t = o.t;
         // the loop, sampled: closure, orientation, centroid, radius, vector area
@@ -261,6 +425,26 @@ impl Fill {
             starts[k1] = in_frame(ss1, sw1, tc);
             corner_angles.push(line_angle(ss0.cross(sw0), ss1.cross(sw1)));
         }
+        // order 6, corners: the second cross derivative `Q = d²/du² S(s₀ + αu, w + βu)` from
+        // each side, their mean `Q_c`, and the correction `Q_c − Q` in each edge's frame
+        // `(S_s, S_w, S_s × S_w)`; its normal part is the neighbours' curvature mismatch
+        let mut starts2 = vec![[0.0; 3]; n];
+        let mut ends2 = vec![[0.0; 3]; n];
+        let mut corner_curvature_gaps = Vec::new();
+        if o.order == 6 {
+            for k in 0..n {
+                let k1 = (k + 1) % n;
+                let f0 = second_frame(&edges[k].surface, edges[k].s0, edges[k].w.1, t);
+                let f1 = second_frame(&edges[k1].surface, edges[k1].s0, edges[k1].w.0, t);
+                let (q0, q1) = (second(&f0, ends[k]), second(&f1, starts[k1]));
+                let qc = (q0 + q1) * 0.5;
+                ends2[k] = in_frame3(f0[1], f0[2], f0[1].cross(f0[2]), qc - q0);
+                starts2[k1] = in_frame3(f1[1], f1[2], f1[1].cross(f1[2]), qc - q1);
+                let tc = f0[1] * ends[k].0 + f0[2] * ends[k].1;
+                let nrm = f0[1].cross(f0[2]).normalized().unwrap_or(Vec3::ZERO);
+                corner_curvature_gaps.push((q1 - q0).dot(nrm).abs() / tc.dot(tc) * radius);
+            }
+        }
         let pieces: Vec<Piece> = edges
             .iter()
             .enumerate()
@@ -272,37 +456,62 @@ impl Fill {
                 c: cs[k],
                 start: starts[k],
                 end: ends[k],
+                start2: starts2[k],
+                end2: ends2[k],
             })
             .collect();
         let position = Arc::new(LoopData { pieces: pieces.clone(), order: 0, blend: o.corner_blend });
-        let cross = Arc::new(LoopData { pieces, order: 1, blend: o.corner_blend });
+        let cross = Arc::new(LoopData { pieces: pieces.clone(), order: 1, blend: o.corner_blend });
         // the pole
         let x0 = position.eval(&[0.0, t]);
         let Some(e1) = ((x0 - centroid) - normal * (x0 - centroid).dot(normal)).normalized() else {
             return Err(FillError::Loop("the loop's first point is above its centroid".into()));
         };
         let e2 = normal.cross(e1);
-        let mean_tan = (0..n)
-            .map(|k| {
-                let e = &edges[k];
-                let (_, ss, _) = point_frame(e, 0.5 * (e.w.0 + e.w.1), t);
-                let d = (ss * cs[k]).normalized().unwrap_or(Vec3::ZERO);
-                let up = d.dot(normal);
-                up / (1.0 - up * up).max(1e-12).sqrt()
-            })
-            .sum::<f64>()
-            / n as f64;
-        let pole = o.pole.unwrap_or(centroid + normal * (o.height * radius * mean_tan / 2.0));
-        let rho = o.ring.unwrap_or(radius * edges.iter().map(|e| e.fullness).sum::<f64>() / n as f64);
         let fixed = |centre: Vec3, rho: f64| -> FieldRef { Arc::new(Ring { centre, e1, e2, rho }) };
-        let conds = [
-            Condition { u: 0.0, order: 0, data: position.clone() },
-            Condition { u: 0.0, order: 1, data: cross },
-            Condition { u: 1.0, order: 0, data: fixed(pole, 0.0) },
-            Condition { u: 1.0, order: 1, data: fixed(Vec3::ZERO, -rho) },
-        ];
+        let mut conds =
+            vec![Condition { u: 0.0, order: 0, data: position.clone() }, Condition { u: 0.0, order: 1, data: cross }];
+        if o.order == 6 {
+            let second = Arc::new(LoopData { pieces, order: 2, blend: o.corner_blend });
+            conds.push(Condition { u: 0.0, order: 2, data: second });
+        }
+        // the pole's data, `X = P`, `X_u = −ρ (cos v e₁ + sin v e₂)`, order 6 also
+        // `X_uu = σ n̄`: what the user did not set is chosen by least bending
+        let mean_fullness = edges.iter().map(|e| e.fullness).sum::<f64>() / n as f64;
+        let ring_free = o.ring.is_none() && !(o.order == 6 && o.pole_curvature.is_some());
+        let free =
+            PoleData { pole: o.pole.is_none(), ring: ring_free, sigma: o.order == 6 && o.pole_curvature.is_none() };
+        let mut data = PoleData {
+            pole: o.pole.unwrap_or(Vec3::ZERO),
+            ring: o.ring.unwrap_or(if ring_free { 0.0 } else { radius * mean_fullness }),
+            sigma: 0.0,
+        };
+        if let Some(k) = o.pole_curvature {
+            data.sigma = k * data.ring * data.ring;
+        }
+        let with_pole = |d: &PoleData, loop_conds: &[Condition]| {
+            let mut c = loop_conds.to_vec();
+            c.push(Condition { u: 1.0, order: 0, data: fixed(d.pole, 0.0) });
+            c.push(Condition { u: 1.0, order: 1, data: fixed(Vec3::ZERO, -d.ring) });
+            if o.order == 6 {
+                c.push(Condition { u: 1.0, order: 2, data: fixed(normal * d.sigma, 0.0) });
+            }
+            c
+        };
+        if free.pole || free.ring || free.sigma {
+            let best = least_bending(&conds, &data, &free, &with_pole, o, n)?;
+            data = best;
+            if free.pole {
+                data.pole = centroid + (data.pole - centroid) * o.height;
+            }
+        }
+        let pole = data.pole;
+        let rho = data.ring;
+        let conds = with_pole(&data, &conds);
+        let pole_curvature = (o.order == 6).then(|| data.sigma / (rho * rho));
         let patch = Arc::new(SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?);
-        let report = FillReport { corner_angles, pole, centroid, radius, normal };
+        let report =
+            FillReport { corner_angles, pole, centroid, radius, normal, corner_curvature_gaps, pole_curvature };
         Ok(Fill { patch, conditions: conds.to_vec(), position, report, t })
     }
 
@@ -311,7 +520,8 @@ impl Fill {
         &self.patch
     }
 
-    /// Its four conditions: loop and cross tangent at `u = 0`, pole and ring at `u = 1`.
+    /// Its conditions: loop, cross tangent (and, order 6, second cross derivative) at
+    /// `u = 0`; pole, ring (and the cap's second derivative) at `u = 1`.
     /// The loop's data answer [`Field::host_normal`] with the neighbour's normal.
     pub fn conditions(&self) -> &[Condition] {
         &self.conditions
@@ -329,26 +539,52 @@ impl Fill {
         let mut out = EdgeContinuity::default();
         for k in 0..n * per_edge {
             let v = TAU * k as f64 / (n * per_edge) as f64;
-            let d = self.patch.derivatives(0.0, v, 1, 1);
-            let (p, ss, sw) = self.position.frame(v, self.t);
-            out.g1 = crate::num::max_nan(out.g1, line_angle(d[2].cross(d[1]), ss.cross(sw)));
-            out.gap = crate::num::max_nan(out.gap, (d[0] - p).norm() / self.report.radius);
+            // index i·3 + j holds ∂uⁱ∂vʲ
+            let d = self.patch.derivatives(0.0, v, 2, 2);
+            let f = self.position.frame2(v, self.t);
+            out.g1 = crate::num::max_nan(out.g1, line_angle(d[3].cross(d[1]), f[1].cross(f[2])));
+            out.gap = crate::num::max_nan(out.gap, (d[0] - f[0]).norm() / self.report.radius);
+            // both second fundamental forms against the fill's normal, in one orthonormal
+            // basis of its tangent plane
+            let nrm = d[3].cross(d[1]).normalized().unwrap_or(Vec3::ZERO);
+            let e1 = d[1].normalized().unwrap_or(Vec3::ZERO);
+            let e2 = nrm.cross(e1);
+            let fill = second_form_in([d[3], d[1], d[6], d[4], d[2]], nrm, e1, e2);
+            let nb = second_form_in([f[1], f[2], f[3], f[4], f[5]], nrm, e1, e2);
+            let diff = [[fill[0][0] - nb[0][0], fill[0][1] - nb[0][1]], [fill[1][0] - nb[1][0], fill[1][1] - nb[1][1]]];
+            out.g2 = crate::num::max_nan(out.g2, sym_norm(diff) * self.report.radius);
             out.samples += 1;
         }
         out
     }
 
-    /// Folds: grid points `(u, v)`, `u < 1`, where `X_u × X_v` vanishes or turns against
-    /// the loop's normal orientation, on an `nu × nv` grid.
+    /// Folds: points of an `nu × nv` grid (`u ≤ 0.98`, away from the pole) where the
+    /// parametrisation degenerates or turns over: `X_u × X_v` vanishes (below 1e-9 of its
+    /// median length), is not finite, or points against its value at the next grid point in
+    /// `u` or in `v`. A surface that curves round (a fill wrapping a wing's nose) keeps its
+    /// orientation from point to point, so only a real fold is counted.
     pub fn folds(&self, nu: usize, nv: usize) -> usize {
         let us: Vec<f64> = (0..nu).map(|i| 0.98 * i as f64 / (nu - 1) as f64).collect();
         let vs: Vec<f64> = (0..nv).map(|j| TAU * (j as f64 + 0.5) / nv as f64).collect();
         let g = self.patch.grid(&us, &vs);
-        let signs: Vec<f64> = g.iter().map(|d| d[1].cross(d[2]).dot(self.report.normal)).collect();
-        let pos = signs.iter().filter(|s| **s > 0.0).count();
-        let majority = if 2 * pos >= signs.len() { 1.0 } else { -1.0 };
-        // zero or NaN counts as a fold
-        signs.iter().filter(|s| (**s * majority).is_nan() || **s * majority <= 0.0).count()
+        let normals: Vec<Vec3> = g.iter().map(|d| d[1].cross(d[2])).collect();
+        let mut lengths: Vec<f64> = normals.iter().map(|n| n.norm()).collect();
+        lengths.sort_by(f64::total_cmp);
+        let tiny = 1e-9 * lengths[lengths.len() / 2];
+        let at = |i: usize, j: usize| normals[i * nv + j % nv];
+        let mut folds = 0;
+        for i in 0..nu {
+            for j in 0..nv {
+                let n = at(i, j);
+                // not positive, NaN included
+                let against = |x: f64| x.is_nan() || x <= 0.0;
+                let flips = (i + 1 < nu && against(n.dot(at(i + 1, j)))) || against(n.dot(at(i, j + 1)));
+                if flips || against(n.norm() - tiny) {
+                    folds += 1;
+                }
+            }
+        }
+        folds
     }
 }
 

@@ -108,3 +108,96 @@ fn sphere_fill_parameter_scan() {
         }
     }
 }
+
+/// Order 6 on the three sphere holes: G1 and G2 to round-off along every edge (the sphere
+/// meets itself G2 at every corner, so no corner correction has a normal part), no fold.
+/// The G1-only fill of the same hole misses the curvature, so the G2 measure can fail.
+#[test]
+fn sphere_holes_are_filled_with_exact_g2_at_order_6() {
+    for (n, deg) in [(3, 50.0), (5, 40.0), (6, 60.0)] {
+        let theta = f64::to_radians(deg);
+        let o = FillOptions { order: 6, ..Default::default() };
+        let fill = Fill::new(&sphere_hole(n, theta), &o).unwrap();
+        assert_eq!(fill.patch().order(), 6);
+        let c = fill.edge_continuity(400);
+        // G1 and gap as at order 4; G2: second derivatives of data and patch carry
+        // round-off ~1e-14 relative (the remainder's second-derivative cardinal function
+        // and the data's jets), far below the 1e-8
+        assert!(c.g1 <= 1e-9, "{n}-gon: G1 angle {}", c.g1);
+        assert!(c.gap <= 1e-12, "{n}-gon: gap {}", c.gap);
+        assert!(c.g2 <= 1e-8, "{n}-gon: G2 gap {}", c.g2);
+        let r = fill.report();
+        assert!(r.corner_curvature_gaps.iter().all(|g| *g < 1e-12), "{:?}", r.corner_curvature_gaps);
+        // the least-bending cap bends like the sphere (−1 against the outward normal)
+        let k = r.pole_curvature.unwrap();
+        assert!(k < 0.0, "pole curvature {k}");
+        assert_eq!(fill.folds(41, 200), 0, "{n}-gon folds");
+        let dev = sphere_deviation(fill.patch());
+        let g1_only = Fill::new(&sphere_hole(n, theta), &FillOptions::default()).unwrap().edge_continuity(100);
+        eprintln!(
+            "order 6, {n} sides, θ = {deg}°: G1 {:.1e} rad, gap {:.1e}, G2 {:.1e} (order 4: {:.1e}), max |r − 1| {dev:.2e}",
+            c.g1, c.gap, c.g2, g1_only.g2
+        );
+        assert!(g1_only.g2 > 1e-3, "the order-4 fill matches the curvature: {}", g1_only.g2);
+        assert!(dev < 0.2, "{n}-gon: the fill strays {dev} from the sphere");
+    }
+}
+
+/// The second fundamental form in an orthonormal basis against a closed form: the unit
+/// sphere `(cos v sin u, sin v sin u, cos u)` has `II = −I` against the outward normal in
+/// every basis; a cylinder of radius 2 has `−1/2` around and 0 along its axis.
+#[test]
+fn second_form_of_sphere_and_cylinder() {
+    let (u, v) = (0.7_f64, 1.9_f64);
+    let (su, cu, sv, cv) = (u.sin(), u.cos(), v.sin(), v.cos());
+    let x = Vec3::new(cv * su, sv * su, cu);
+    let xu = Vec3::new(cv * cu, sv * cu, -su);
+    let xv = Vec3::new(-sv * su, cv * su, 0.0);
+    let xuu = x * -1.0;
+    let xuv = Vec3::new(-sv * cu, cv * cu, 0.0);
+    let xvv = Vec3::new(-cv * su, -sv * su, 0.0);
+    let e1 = (xu * 0.6 + xv * 0.3).normalized().unwrap();
+    let e2 = x.cross(e1);
+    let b = second_form_in([xu, xv, xuu, xuv, xvv], x, e1, e2);
+    for (got, want) in [(b[0][0], -1.0), (b[0][1], 0.0), (b[1][1], -1.0)] {
+        assert!((got - want).abs() < 1e-14, "{b:?}");
+    }
+    // cylinder (2 cos v, 2 sin v, u): X_u = e_z, X_v = (−2 sin v, 2 cos v, 0)
+    let n = Vec3::new(cv, sv, 0.0);
+    let (xu, xv) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(-2.0 * sv, 2.0 * cv, 0.0));
+    let xvv = Vec3::new(-2.0 * cv, -2.0 * sv, 0.0);
+    let e1 = Vec3::new(-sv, cv, 0.0);
+    let b = second_form_in([xu, xv, Vec3::ZERO, Vec3::ZERO, xvv], n, e1, n.cross(e1));
+    for (got, want) in [(b[0][0], -0.5), (b[0][1], 0.0), (b[1][1], 0.0)] {
+        assert!((got - want).abs() < 1e-15, "{b:?}");
+    }
+    assert_eq!(sym_norm([[-0.5, 0.0], [0.0, 0.0]]), 0.5);
+    assert!(sym_norm([[f64::NAN, 0.0], [0.0, 0.0]]).is_nan());
+}
+
+/// Set pole data are met: `X(1, v) = P`, `X_u(1, v) = −ρ (cos v e₁ + sin v e₂)` (length ρ,
+/// perpendicular to the loop normal) and, at order 6, `X_uu(1, v) = κ ρ² n̄`.
+#[test]
+fn set_pole_data_are_met() {
+    let (p, rho, kappa) = (Vec3::new(0.01, -0.02, 1.05), 0.4, -1.3);
+    let o = FillOptions { order: 6, pole: Some(p), ring: Some(rho), pole_curvature: Some(kappa), ..Default::default() };
+    let fill = Fill::new(&sphere_hole(5, 0.7), &o).unwrap();
+    let nbar = fill.report().normal;
+    assert!((nbar.z - 1.0).abs() < 1e-12, "{nbar:?}");
+    for v in [0.0, 0.9, 2.5, 4.4] {
+        let d = fill.patch().derivatives(1.0, v, 2, 0);
+        assert!((d[0] - p).norm() < 1e-13, "{:?}", d[0]);
+        assert!((d[1].norm() - rho).abs() < 1e-13 && d[1].dot(nbar).abs() < 1e-13, "{:?}", d[1]);
+        assert!((d[2] - nbar * (kappa * rho * rho)).norm() < 1e-12, "{:?}", d[2]);
+    }
+    assert!((fill.report().pole_curvature.unwrap() - kappa).abs() < 1e-14);
+}
+
+/// A ring turned inside out (negative length) turns the parametrisation over between the
+/// loop and the pole: the fold count sees it.
+#[test]
+fn an_inverted_ring_is_a_fold() {
+    let o = FillOptions { pole: Some(Vec3::new(0.0, 0.0, 1.0)), ring: Some(-0.4), ..Default::default() };
+    let fill = Fill::new(&sphere_hole(5, 0.7), &o).unwrap();
+    assert!(fill.folds(41, 200) > 0);
+}

@@ -818,6 +818,8 @@ fn build_patch(
         (rp.ring.is_some(), "ring"),
         (rp.corner_blend.is_some(), "corner_blend"),
         (rp.fullness.is_some(), "fullness"),
+        (rp.order.is_some(), "order"),
+        (rp.pole_curvature.is_some(), "pole_curvature"),
     ] {
         only(present, name, PatchKind::Fill)?;
     }

@@ -1,5 +1,5 @@
-//! `kind = "fill"`: an N-sided hole between `[surfaces.*]` filled with exact G1
-//! (`pdeshape_core::fill`).
+//! `kind = "fill"`: an N-sided hole between `[surfaces.*]` filled with exact G1 (order 4)
+//! or G2 (order 6) (`pdeshape_core::fill`).
 
 use super::build::{Ctx, R, find_surface, span};
 use super::raw::{NumOrExpr, RawPatch};
@@ -63,6 +63,25 @@ pub(super) fn build_fill(
         height: num(&rp.height, "height", 1.0)?,
         ring: rp.ring.as_ref().map(|x| ctx.num(x.get_ref(), span(x), &format!("{key}.ring"))).transpose()?,
         t: 0.0,
+        order: match &rp.order {
+            Some(o) => match *o.get_ref() {
+                4 => 4,
+                6 => 6,
+                x => {
+                    return Err(ctx.err(
+                        span(o),
+                        format!("{key}.order"),
+                        format!("a fill's order is 4 (G1) or 6 (G2), not {x}"),
+                    ));
+                }
+            },
+            None => 4,
+        },
+        pole_curvature: rp
+            .pole_curvature
+            .as_ref()
+            .map(|x| ctx.num(x.get_ref(), span(x), &format!("{key}.pole_curvature")))
+            .transpose()?,
         spectral: SpectralOptions { a, modes, omega },
     };
     let fill = Fill::new(&list, &opts).map_err(|e| ctx.err(span(edges), format!("{key}.edges"), e.to_string()))?;

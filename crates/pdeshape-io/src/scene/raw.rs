@@ -194,6 +194,10 @@ pub struct RawPatch {
     pub ring: Option<Spanned<NumOrExpr>>,
     /// Fills: half-width of the corner blends, as a fraction of an edge.
     pub corner_blend: Option<Spanned<NumOrExpr>>,
+    /// Fills: PDE order, 4 (G1) or 6 (G2).
+    pub order: Option<Spanned<i64>>,
+    /// Fills, order 6: the cap's normal curvature at the pole.
+    pub pole_curvature: Option<Spanned<NumOrExpr>>,
     /// Fills: cross-tangent length relative to the loop's radius, for every edge.
     pub fullness: Option<Spanned<NumOrExpr>>,
     /// Blends: the primary surface at `u = 0` (conditions of orders 0, 1, 2 from its trimline).
