@@ -81,18 +81,34 @@ pub(super) fn build_trim(
     let rect = Rect { min: [0.0, domain.start], max: [1.0, domain.end] };
     // validate in the patch's own parameters (errors quote its u, v)
     TrimRegion::new(rect, curves.clone()).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-    // mesh in the metric-scaled plane (u, k v), k = mean|X_v| / mean|X_u|
-    let scale = [1.0, metric_scale(surface)];
-    let scaled_rect = Rect { min: [0.0, domain.start * scale[1]], max: [1.0, domain.end * scale[1]] };
-    let scaled: Vec<_> = curves.iter().map(|(n, c)| (n.clone(), c.scaled(scale))).collect();
-    let region = TrimRegion::new(scaled_rect, scaled).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-    let map = LaplaceMap::new(region, modes, Some(columns));
-    let mut grid = trim_grid(&map, &TrimOptions { rings, columns, modes, ..Default::default() })
-        .map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-    for p in &mut grid.points {
-        p[1] /= scale[1];
+    // mesh in the metric-scaled plane (u, k v), k = mean|X_v| / mean|X_u|; the scaling is a
+    // heuristic, so where its map keeps folds after repair, the geometric mean of k and 1
+    // and then the plain parameter plane are tried before the first failure is reported
+    let k = metric_scale(surface);
+    let mut first_error = None;
+    for ks in [k, k.sqrt(), 1.0] {
+        let scale = [1.0, ks];
+        let scaled_rect = Rect { min: [0.0, domain.start * scale[1]], max: [1.0, domain.end * scale[1]] };
+        let scaled: Vec<_> = curves.iter().map(|(n, c)| (n.clone(), c.scaled(scale))).collect();
+        let region = TrimRegion::new(scaled_rect, scaled).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
+        let map = LaplaceMap::new(region, modes, Some(columns));
+        match trim_grid(&map, &TrimOptions { rings, columns, modes, ..Default::default() }) {
+            Ok(mut grid) => {
+                for p in &mut grid.points {
+                    p[1] /= scale[1];
+                }
+                return Ok(TrimSetup { map: Arc::new(map), grid: Arc::new(grid), curves, scale });
+            }
+            Err(e) => {
+                first_error.get_or_insert(e);
+                if k == 1.0 {
+                    break;
+                }
+            }
+        }
     }
-    Ok(TrimSetup { map: Arc::new(map), grid: Arc::new(grid), curves, scale })
+    let e = first_error.expect("at least one attempt");
+    Err(ctx.err(span(raw), &key, e.to_string()))
 }
 
 /// `mean |X_v| / mean |X_u|` over a 9 × 9 grid: the factor on `v` that makes the
@@ -113,6 +129,17 @@ fn metric_scale(s: &dyn Surface) -> f64 {
 
 /// The curve `X_P(C(t))` for `trim = "P.C"`: trim curve `C` of the earlier patch `P`.
 pub(super) fn trim_condition(ctx: &Ctx, name: &Spanned<String>, key: &str, done: &[ScenePatch]) -> R<FieldRef> {
+    let (surface, curve) = find_trim_curve(ctx, name, key, done)?;
+    Ok(Arc::new(CurveOnSurface { surface, curve }))
+}
+
+/// The patch and trim curve named `"P.C"` (an earlier patch `P`, its curve `C`).
+pub(super) fn find_trim_curve(
+    ctx: &Ctx,
+    name: &Spanned<String>,
+    key: &str,
+    done: &[ScenePatch],
+) -> R<(Arc<dyn Surface>, TrimCurve)> {
     let text = name.get_ref();
     let Some((pname, cname)) = text.split_once('.') else {
         return Err(ctx.err(span(name), key, format!("`{text}` is not of the form \"PATCH.CURVE\"")));
@@ -140,5 +167,5 @@ pub(super) fn trim_condition(ctx: &Ctx, name: &Spanned<String>, key: &str, done:
         ));
     };
     let surface: Arc<dyn Surface> = p.surface.clone();
-    Ok(Arc::new(CurveOnSurface { surface, curve: c.clone() }))
+    Ok((surface, c.clone()))
 }
