@@ -186,7 +186,8 @@ fn add_continuity_fields(m: &mut Mesh, p: &ScenePatch, s: &dyn pdeshape_core::pa
 }
 
 /// Per-vertex seam fields of a patch attached to trim curves ([`attached_ends`]): at each
-/// vertex, `c0_gap` and `g1_angle` of its `v` on the nearest attached end.
+/// vertex, `c0_gap` and `g1_angle` of its `v` on the nearest attached end; for a fill also
+/// `g2_gap` (the curvature gap of `Fill::edge_gaps_at`).
 fn add_attached_fields(m: &mut Mesh, p: &ScenePatch) {
     use rayon::prelude::*;
     let ends = attached_ends(p);
@@ -212,6 +213,12 @@ fn add_attached_fields(m: &mut Mesh, p: &ScenePatch) {
             let values = gaps.iter().map(|g| pick(g).unwrap_or(0.0)).collect();
             m.fields.push(ScalarField { name: name.into(), values });
         }
+    }
+    // a fill also knows its neighbours' second fundamental forms: the curvature gap
+    // (relative to the loop radius) along its loop, spread over the rows
+    if let Some(f) = &p.fill {
+        let g2: Vec<f64> = (0..nv).into_par_iter().map(|j| f.edge_gaps_at(dom.at(m.uvs[j][1])).g2).collect();
+        m.fields.push(ScalarField { name: "g2_gap".into(), values: (0..nu * nv).map(|k| g2[k % nv]).collect() });
     }
 }
 

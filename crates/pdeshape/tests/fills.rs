@@ -181,6 +181,15 @@ fn wing_root_is_filled_with_exact_g2() {
     }
     eprintln!("fill-wing-root: G1 {g1:.1e} rad, gap {gap:.1e}, G2 {g2:.1e}; wing edge K, H gap {worst:.1e} (relative)");
     assert!(worst < 1e-8, "{worst}");
+    // the editor's seam colouring gets the curvature gap per vertex
+    let m = model::editor_mesh(p, None).unwrap();
+    let g2v = m
+        .field("g2_gap")
+        .expect("a g2_gap field")
+        .values
+        .iter()
+        .fold(0.0, |a: f64, &x| pdeshape_core::num::max_nan(a, x));
+    assert!(g2v <= 1e-8, "{g2v}");
 }
 
 /// A fill's order is 4 or 6.
@@ -188,4 +197,72 @@ fn wing_root_is_filled_with_exact_g2() {
 fn fill_order_is_checked() {
     let text = std::fs::read_to_string(example("fill-sphere-pentagon.toml")).unwrap();
     fails(&text.replace("modes = 12", "modes = 12\norder = 5"), &["patches.cap.order", "4 (G1) or 6 (G2), not 5"]);
+}
+
+/// Edges on trim curves of another patch: the dolphin's dorsal trim hole, cut into three
+/// arcs of the trim curve, plugged with G2 to the order-14 body (the fill's loop data are
+/// the body's own exact derivatives through the trim curve).
+#[test]
+fn a_trim_hole_is_plugged_with_g2() {
+    let third = std::f64::consts::TAU / 3.0;
+    let text = std::fs::read_to_string(example("dolphin.toml")).unwrap()
+        + &format!(
+            "\n[patches.plug]\nkind = \"fill\"\norder = 6\nedges = [\n{}]\n",
+            (0..3)
+                .map(|k| format!(
+                    "  {{ trim = \"body.dorsal\", t = [{:?}, {:?}] }},\n",
+                    k as f64 * third,
+                    (k + 1) as f64 * third
+                ))
+                .collect::<String>()
+        );
+    let scene = Scene::parse(&text, "plug.toml", "plug", &Default::default()).unwrap();
+    let p = scene.patch("plug").unwrap();
+    let d = model::patch_diagnostics(p);
+    let f = &d["fill"];
+    let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
+    let (g1, gap, g2) = (get("g1_max_radians"), get("gap_max_relative"), get("g2_max_relative"));
+    eprintln!("dolphin dorsal plug: G1 {g1:.1e} rad, gap {gap:.1e}, G2 {g2:.1e}");
+    assert!(g1 <= 1e-9 && gap <= 1e-12 && g2 <= 1e-8, "G1 {g1}, gap {gap}, G2 {g2}");
+    assert_eq!(f["folds"], 0);
+    // the corners lie on one smooth surface: no mismatch of planes or curvatures
+    for k in ["corner_normal_angles_radians", "corner_curvature_gaps_relative"] {
+        for a in f[k].as_array().unwrap() {
+            assert!(a.as_f64().unwrap() < 1e-10, "{k}: {a}");
+        }
+    }
+    // independently: the plug's loop is the body at the trim curve
+    let body = scene.patch("body").unwrap();
+    let (_, curve) = body.trim.as_ref().unwrap().curves.iter().find(|(n, _)| n == "dorsal").unwrap();
+    for k in 0..300 {
+        let v = std::f64::consts::TAU * k as f64 / 300.0;
+        let uv = curve.point(v);
+        let want = body.surface.point(uv[0], uv[1]);
+        let got = p.surface.point(0.0, v);
+        assert!((got - want).norm() < 1e-12 * (1.0 + want.norm()), "{v}: {got} vs {want}");
+    }
+}
+
+/// Edge forms: isoline keys with `t`, a trim edge naming an unknown patch, a curve with a
+/// bad expression, `surface` with `trim`.
+#[test]
+fn edge_forms_are_checked() {
+    let text = std::fs::read_to_string(example("fill-sphere-pentagon.toml")).unwrap();
+    let first = text.lines().find(|l| l.contains("{ surface = \"edge0\"")).unwrap().to_string();
+    fails(
+        &text.replace(&first, "  { surface = \"edge0\", s = 0, w = [0, 1], t = [0, 1] },"),
+        &["patches.cap.edges[0]", "an isoline edge takes `s` and `w` (not `t`)"],
+    );
+    fails(
+        &text.replace(&first, "  { trim = \"nope.hole\", t = [0, 1] },"),
+        &["patches.cap.edges[0].trim", "unknown patch `nope`"],
+    );
+    fails(
+        &text.replace(&first, "  { surface = \"edge0\", curve = [\"0\", \"t +\"], t = [0, 1] },"),
+        &["patches.cap.edges[0].curve[1]"],
+    );
+    fails(
+        &text.replace(&first, "  { surface = \"edge0\", trim = \"a.b\", t = [0, 1] },"),
+        &["patches.cap.edges[0]", "do not combine"],
+    );
 }

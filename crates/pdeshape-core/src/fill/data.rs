@@ -148,6 +148,19 @@ impl LoopData {
         })
     }
 
+    /// The cross tangent's weights and their `v`-derivatives, `[(α, α′), (β, β′)]`.
+    fn weights_series(&self, p: &Piece, dv: f64) -> [(f64, f64); 2] {
+        let span = TAU / self.pieces.len() as f64;
+        let h = self.blend * span;
+        let (ws, we) = (bump(dv / h, 1.0 / h, 1), bump((span - dv) / h, -1.0 / h, 1));
+        let w = |k: usize| (ws[k], we[k]);
+        let ((s0, e0), (s1, e1)) = (w(0), w(1));
+        [
+            ((1.0 - s0 - e0) * p.c + s0 * p.start.0 + e0 * p.end.0, (-s1 - e1) * p.c + s1 * p.start.0 + e1 * p.end.0),
+            (s0 * p.start.1 + e0 * p.end.1, s1 * p.start.1 + e1 * p.end.1),
+        ]
+    }
+
     /// The values of the cross tangent's weights `(α, β)` on piece `p` at `v − V_k = dv`.
     fn weights(&self, p: &Piece, dv: f64) -> (f64, f64) {
         let span = TAU / self.pieces.len() as f64;
@@ -216,6 +229,15 @@ impl Field for LoopData {
             p.surface.derivatives_in(&on, 1, &mut along_w);
             let (alpha, beta) = self.weights(p, dv);
             out[0] = along_s[1] * alpha + along_w[1] * beta;
+        } else if self.order == 1 && out.len() == 2 {
+            // T = α S_s + β S_w, T′ = α′ S_s + α λ S_sw + β′ S_w + β λ S_ww (one small jet
+            // of the neighbour for the mixed derivative)
+            let j = p.surface.jet(&on, JetShape::new(&[1, 2, 0]));
+            let g = |m: [usize; 3], f: f64| Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m)) * f;
+            let (ss, sw, ssw, sww) = (g([1, 0, 0], 1.0), g([0, 1, 0], 1.0), g([1, 1, 0], 1.0), g([0, 2, 0], 2.0));
+            let [(a, da), (b, db)] = self.weights_series(p, dv);
+            out[0] = ss * a + sw * b;
+            out[1] = ss * da + sw * db + (ssw * a + sww * b) * p.lambda;
         } else {
             crate::data::derivatives_by_jet(self, at, slot, out);
         }
@@ -254,11 +276,11 @@ mod tests {
             start2: [0.3, -0.1, 0.2],
             end2: [-0.2, 0.4, 0.1],
         };
-        for order in [0, 1] {
+        // positions to three v-derivatives; the cross tangent's value alone and with one
+        for (order, n) in [(0, 4), (1, 1), (1, 2)] {
             let d = LoopData { pieces: vec![piece(0.0), piece(1.0), piece(2.0)], order, blend: 0.3 };
             for v in [0.05, 0.4, 1.0, 2.2, 3.3, 6.1] {
                 let mut fast = [Vec3::ZERO; 4];
-                let n = if order == 0 { 4 } else { 1 };
                 d.derivatives_in(&[v, 0.0], 0, &mut fast[..n]);
                 let mut slow = [Vec3::ZERO; 4];
                 crate::data::derivatives_by_jet(&d, &[v, 0.0], 0, &mut slow[..n]);

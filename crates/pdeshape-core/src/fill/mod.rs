@@ -49,6 +49,7 @@
 //! pole — by linear least squares (see [`FillOptions`]). `height` scales the chosen pole's
 //! offset from the loop's centroid.
 
+mod curve;
 mod data;
 
 use crate::Vec3;
@@ -56,6 +57,7 @@ use crate::data::{Field, FieldRef, VecJet};
 use crate::jet::{Jet, JetShape};
 use crate::patch::{Condition, Surface, VDomain};
 use crate::spectral::{SpectralError, SpectralOptions, SpectralPatch};
+pub use curve::{AlongCurve, DomainCurve, Host};
 use data::{LoopData, Piece, second_frame};
 use std::f64::consts::TAU;
 use std::sync::Arc;
@@ -206,6 +208,19 @@ impl Field for Ring {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot == 1
     }
+    /// `∂ᵏ/∂vᵏ = ρ (e₁ cos(v + kπ/2) + e₂ sin(v + kπ/2))` (plus the centre at `k = 0`).
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        let v = at[0];
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = if slot != 0 && k > 0 {
+                Vec3::ZERO
+            } else {
+                let ph = if slot == 0 { v + k as f64 * std::f64::consts::FRAC_PI_2 } else { v };
+                let base = if k == 0 { self.centre } else { Vec3::ZERO };
+                base + (self.e1 * ph.cos() + self.e2 * ph.sin()) * self.rho
+            };
+        }
+    }
 }
 
 fn point_frame(e: &FillEdge, w: f64, t: f64) -> (Vec3, Vec3, Vec3) {
@@ -220,6 +235,73 @@ fn in_frame(x: Vec3, y: Vec3, z: Vec3) -> (f64, f64) {
     let (xz, yz) = (x.dot(z), y.dot(z));
     let det = xx * yy - xy * xy;
     ((yy * xz - xy * yz) / det, (xx * yz - xy * xz) / det)
+}
+
+/// The closest points of segments `[p0, p1]` and `[q0, q1]` (clamped parameters).
+fn segment_distance(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (f64, Vec3) {
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
+    let (c, b) = (d1.dot(r), d1.dot(d2));
+    let denom = a * e - b * b;
+    let mut s = if denom > 1e-300 { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+    let mut t = if e > 1e-300 { (b * s + f) / e } else { 0.0 };
+    if t < 0.0 {
+        t = 0.0;
+        s = if a > 1e-300 { (-c / a).clamp(0.0, 1.0) } else { 0.0 };
+    } else if t > 1.0 {
+        t = 1.0;
+        s = if a > 1e-300 { ((b - c) / a).clamp(0.0, 1.0) } else { 0.0 };
+    }
+    let (x, y) = (p0 + d1 * s, q0 + d2 * t);
+    ((x - y).norm(), x)
+}
+
+/// Two segments of the closed polyline `pts`, not neighbours (at least three apart), closer
+/// than `tol` (NaN positions count): their indices and the place.
+///
+/// Segments are grouped in runs of 8 whose bounding boxes (grown by `tol`) are compared
+/// first; only runs whose boxes meet are compared segment by segment.
+fn self_crossing(pts: &[Vec3], tol: f64) -> Option<(usize, usize, Vec3)> {
+    let m = pts.len();
+    if pts.iter().any(|p| !p.is_finite()) {
+        return Some((0, 0, Vec3::new(f64::NAN, f64::NAN, f64::NAN)));
+    }
+    const RUN: usize = 8;
+    let runs: Vec<(Vec3, Vec3)> = (0..m.div_ceil(RUN))
+        .map(|r| {
+            let idx = (r * RUN..((r + 1) * RUN).min(m)).flat_map(|i| [i, (i + 1) % m]);
+            let (lo, hi) = idx.fold(
+                (
+                    Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
+                    Vec3::new(-f64::INFINITY, -f64::INFINITY, -f64::INFINITY),
+                ),
+                |(lo, hi), i| (lo.min(pts[i]), hi.max(pts[i])),
+            );
+            (lo - Vec3::new(tol, tol, tol), hi + Vec3::new(tol, tol, tol))
+        })
+        .collect();
+    let meet = |a: &(Vec3, Vec3), b: &(Vec3, Vec3)| {
+        a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y && a.0.z <= b.1.z && b.0.z <= a.1.z
+    };
+    for (ra, a) in runs.iter().enumerate() {
+        for (rb, b) in runs.iter().enumerate().skip(ra) {
+            if !meet(a, b) {
+                continue;
+            }
+            for i in ra * RUN..((ra + 1) * RUN).min(m) {
+                for j in (rb * RUN).max(i + 3)..((rb + 1) * RUN).min(m) {
+                    if (i + m - j) % m < 3 {
+                        continue;
+                    }
+                    let (d, p) = segment_distance(pts[i], pts[(i + 1) % m], pts[j], pts[(j + 1) % m]);
+                    if d.is_nan() || d < tol {
+                        return Some((i, j, p));
+                    }
+                }
+            }
+        }
+    }
+    None
 }
 
 /// `(γ, δ, η)` with `γ x + δ y + η z = r` (Cramer's rule; `x, y, z` independent).
@@ -396,6 +478,13 @@ impl Fill {
                 }));
             }
         }
+        if let Some((i, j, p)) = self_crossing(&pts, 1e-3 * radius) {
+            return Err(FillError::Loop(format!(
+                "the loop crosses itself: edge {} comes within 1e-3 of the loop radius of edge {} near {p}",
+                i / per,
+                j / per
+            )));
+        }
         let area =
             (0..pts.len()).fold(Vec3::ZERO, |a, i| a + (pts[i] - centroid).cross(pts[(i + 1) % pts.len()] - centroid));
         let Some(normal) = area.normalized() else {
@@ -532,30 +621,40 @@ impl Fill {
         &self.report
     }
 
-    /// G1 angle and position gap against the neighbours at `per_edge` points of every edge
-    /// (its start corner included), NaN-propagating.
+    /// G1 angle, position gap and curvature gap against the neighbours at `per_edge` points
+    /// of every edge (its start corner included), NaN-propagating.
     pub fn edge_continuity(&self, per_edge: usize) -> EdgeContinuity {
         let n = self.position.pieces.len();
         let mut out = EdgeContinuity::default();
         for k in 0..n * per_edge {
-            let v = TAU * k as f64 / (n * per_edge) as f64;
-            // index i·3 + j holds ∂uⁱ∂vʲ
-            let d = self.patch.derivatives(0.0, v, 2, 2);
-            let f = self.position.frame2(v, self.t);
-            out.g1 = crate::num::max_nan(out.g1, line_angle(d[3].cross(d[1]), f[1].cross(f[2])));
-            out.gap = crate::num::max_nan(out.gap, (d[0] - f[0]).norm() / self.report.radius);
-            // both second fundamental forms against the fill's normal, in one orthonormal
-            // basis of its tangent plane
-            let nrm = d[3].cross(d[1]).normalized().unwrap_or(Vec3::ZERO);
-            let e1 = d[1].normalized().unwrap_or(Vec3::ZERO);
-            let e2 = nrm.cross(e1);
-            let fill = second_form_in([d[3], d[1], d[6], d[4], d[2]], nrm, e1, e2);
-            let nb = second_form_in([f[1], f[2], f[3], f[4], f[5]], nrm, e1, e2);
-            let diff = [[fill[0][0] - nb[0][0], fill[0][1] - nb[0][1]], [fill[1][0] - nb[1][0], fill[1][1] - nb[1][1]]];
-            out.g2 = crate::num::max_nan(out.g2, sym_norm(diff) * self.report.radius);
+            let p = self.edge_gaps_at(TAU * k as f64 / (n * per_edge) as f64);
+            out.g1 = crate::num::max_nan(out.g1, p.g1);
+            out.gap = crate::num::max_nan(out.gap, p.gap);
+            out.g2 = crate::num::max_nan(out.g2, p.g2);
             out.samples += 1;
         }
         out
+    }
+
+    /// The continuity measures of [`EdgeContinuity`] at the loop's point `v` (`samples` 1).
+    pub fn edge_gaps_at(&self, v: f64) -> EdgeContinuity {
+        // index i·3 + j holds ∂uⁱ∂vʲ
+        let d = self.patch.derivatives(0.0, v, 2, 2);
+        let f = self.position.frame2(v, self.t);
+        // both second fundamental forms against the fill's normal, in one orthonormal basis
+        // of its tangent plane
+        let nrm = d[3].cross(d[1]).normalized().unwrap_or(Vec3::ZERO);
+        let e1 = d[1].normalized().unwrap_or(Vec3::ZERO);
+        let e2 = nrm.cross(e1);
+        let fill = second_form_in([d[3], d[1], d[6], d[4], d[2]], nrm, e1, e2);
+        let nb = second_form_in([f[1], f[2], f[3], f[4], f[5]], nrm, e1, e2);
+        let diff = [[fill[0][0] - nb[0][0], fill[0][1] - nb[0][1]], [fill[1][0] - nb[1][0], fill[1][1] - nb[1][1]]];
+        EdgeContinuity {
+            g1: line_angle(d[3].cross(d[1]), f[1].cross(f[2])),
+            gap: (d[0] - f[0]).norm() / self.report.radius,
+            g2: sym_norm(diff) * self.report.radius,
+            samples: 1,
+        }
     }
 
     /// Folds: points of an `nu × nv` grid (`u ≤ 0.98`, away from the pole) where the

@@ -5,8 +5,15 @@ use crate::data::ExprField;
 /// great-circle arcs `S(s, w) = cos s (cos w A + sin w B) + sin s M` at `s = 0` from
 /// `w = 0` (the vertex A) to `w = ∠(A, A′)`, `M = A × A′ / |·|`, `B = M × A`.
 fn sphere_hole(n: usize, theta: f64) -> Vec<FillEdge> {
+    let azimuths: Vec<f64> = (0..n).map(|i| TAU * i as f64 / n as f64).collect();
+    sphere_loop(&azimuths, theta)
+}
+
+/// Great-circle arcs through the points at polar angle θ and the given azimuths, in order.
+fn sphere_loop(azimuths: &[f64], theta: f64) -> Vec<FillEdge> {
+    let n = azimuths.len();
     let vert = |i: usize| {
-        let phi = TAU * i as f64 / n as f64;
+        let phi = azimuths[i % n];
         Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
     };
     (0..n)
@@ -64,7 +71,7 @@ fn sphere_holes_are_filled_with_exact_g1() {
     }
 }
 
-/// Bad loops: too few edges, an open loop, a reversed edge.
+/// Bad loops: too few edges, an open loop, a reversed edge, a loop crossing itself.
 #[test]
 fn bad_loops_are_named() {
     let e = sphere_hole(5, 0.7);
@@ -75,6 +82,11 @@ fn bad_loops_are_named() {
     let mut rev = e.clone();
     rev[2].w = (rev[2].w.1, rev[2].w.0);
     assert!(err(&rev).contains("edge 2 runs the wrong way"), "{}", err(&rev));
+    // a bow tie: the arcs 0 → π and π/2 → 3π/2 cross near the pole
+    let pi = std::f64::consts::PI;
+    let bow = sphere_loop(&[0.0, pi, 0.5 * pi, 1.5 * pi], 0.6);
+    assert!(err(&bow).contains("the loop crosses itself: edge 0 comes within"), "{}", err(&bow));
+    assert!(err(&bow).contains("of edge 2"), "{}", err(&bow));
 }
 
 /// A scan of fullness, ring length and shape parameter with the pole on the sphere, printing
@@ -200,4 +212,21 @@ fn an_inverted_ring_is_a_fold() {
     let o = FillOptions { pole: Some(Vec3::new(0.0, 0.0, 1.0)), ring: Some(-0.4), ..Default::default() };
     let fill = Fill::new(&sphere_hole(5, 0.7), &o).unwrap();
     assert!(fill.folds(41, 200) > 0);
+}
+
+/// The ring's fast derivatives equal its jets: `ρ (e₁ cos(v + kπ/2) + e₂ sin(v + kπ/2))`.
+#[test]
+fn ring_fast_path_matches_its_jets() {
+    let r =
+        Ring { centre: Vec3::new(0.1, 0.2, 0.3), e1: Vec3::new(1.0, 0.0, 0.0), e2: Vec3::new(0.0, 0.6, 0.8), rho: 0.7 };
+    for v in [0.0, 1.3, 5.0] {
+        for slot in [0, 1] {
+            let (mut fast, mut slow) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4]);
+            r.derivatives_in(&[v, 0.0], slot, &mut fast);
+            crate::data::derivatives_by_jet(&r, &[v, 0.0], slot, &mut slow);
+            for k in 0..4 {
+                assert!((fast[k] - slow[k]).norm() < 1e-15, "{v} {slot} {k}: {} {}", fast[k], slow[k]);
+            }
+        }
+    }
 }

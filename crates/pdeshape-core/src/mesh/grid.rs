@@ -53,6 +53,12 @@ fn area_scale<I: ExactSizeIterator<Item = (Vec3, Vec3)>>(d: I) -> f64 {
 ///
 /// Fails (naming the parameters) when the patch evaluates to a non-finite point.
 pub fn grid_mesh(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
+    // one entry into the thread pool for the whole mesh: each parallel step below, called
+    // from outside the pool, would otherwise be a separate hand-over to the workers
+    rayon::scope(|_| grid_mesh_in_pool(s, o))
+}
+
+fn grid_mesh_in_pool(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     assert!(o.nu >= 2 && o.nv >= 2, "a grid mesh needs at least 2 × 2 vertices");
     let (us, vs) = grid_params(s, o);
     let flat = s.grid(&us, &vs);

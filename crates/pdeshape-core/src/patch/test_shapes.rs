@@ -27,3 +27,38 @@ impl Surface for Sphere {
         out
     }
 }
+
+/// The paraboloid `X = (u, v, u² + v²)` over the whole plane (derivatives by hand).
+pub(crate) struct Paraboloid;
+
+impl Surface for Paraboloid {
+    fn v_domain(&self) -> VDomain {
+        VDomain::open(-10.0, 10.0)
+    }
+    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        for i in 0..=du {
+            for j in 0..=dv {
+                let x = match (i, j) {
+                    (0, 0) => u,
+                    (1, 0) => 1.0,
+                    _ => 0.0,
+                };
+                let y = match (i, j) {
+                    (0, 0) => v,
+                    (0, 1) => 1.0,
+                    _ => 0.0,
+                };
+                let z = match (i, j) {
+                    (0, 0) => u * u + v * v,
+                    (1, 0) => 2.0 * u,
+                    (0, 1) => 2.0 * v,
+                    (2, 0) | (0, 2) => 2.0,
+                    _ => 0.0,
+                };
+                out.push(Vec3::new(x, y, z));
+            }
+        }
+        out
+    }
+}

@@ -160,6 +160,12 @@ fn cardinal_set(rate: f64, n: usize, specs: &[CondSpec], kmax: usize) -> Result<
 impl SpectralPatch {
     /// Solves the patch for `conds` (data slots `(v, t)`) over `domain` at time `t`.
     pub fn new(conds: &[Condition], domain: VDomain, opts: SpectralOptions) -> Result<Self, SpectralError> {
+        // one entry into the thread pool for the analysis and the cardinal sets (see
+        // `grid_products`)
+        rayon::scope(|_| Self::new_in_pool(conds, domain, opts))
+    }
+
+    fn new_in_pool(conds: &[Condition], domain: VDomain, opts: SpectralOptions) -> Result<Self, SpectralError> {
         if conds.len() < 2 || !conds.len().is_multiple_of(2) {
             return Err(SpectralError::Options(format!(
                 "a PDE of order 2N needs 2N conditions (an even number ≥ 2); got {}",

@@ -160,6 +160,13 @@ impl Ctx<'_> {
             .map_err(|(i, e)| self.expr_err(span(x), format!("{key}[{i}]"), &texts[i], &e))
     }
 
+    /// A plane curve: two expressions (the third component is 0).
+    pub(super) fn field2(&self, x: &Spanned<[NumOrExpr; 2]>, vars: &[&str], key: &str) -> R<ExprField> {
+        let texts = x.get_ref().each_ref().map(NumOrExpr::text);
+        ExprField::parse([&texts[0], &texts[1], "0"], vars, &self.param_lookup())
+            .map_err(|(i, e)| self.expr_err(span(x), format!("{key}[{i}]"), &texts[i.min(1)], &e))
+    }
+
     pub(super) fn int(&self, x: &Spanned<i64>, lo: i64, hi: i64, key: &str) -> R<i64> {
         let v = *x.get_ref();
         if v < lo || v > hi {
@@ -843,7 +850,7 @@ fn build_patch(
         return build_solid(ctx, pname, &key, p);
     }
     if kind == PatchKind::Fill {
-        return super::fill::build_fill(ctx, pname, &key, p, surfaces);
+        return super::fill::build_fill(ctx, pname, &key, p, surfaces, done);
     }
     let domain = ctx.domain(&rp.v, &format!("{key}.v"))?;
     let resolution = ctx.resolution(&rp.resolution, (33, 65), &format!("{key}.resolution"))?;

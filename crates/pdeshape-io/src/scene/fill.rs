@@ -3,20 +3,26 @@
 
 use super::build::{Ctx, R, find_surface, span};
 use super::raw::{NumOrExpr, RawPatch};
+use super::trim::find_trim_curve;
 use super::{PatchKind, ScenePatch, SceneSurface};
-use pdeshape_core::fill::{Fill, FillEdge, FillOptions};
+use pdeshape_core::data::FieldRef;
+use pdeshape_core::fill::{AlongCurve, DomainCurve, Fill, FillEdge, FillOptions, Host};
 use pdeshape_core::limits::Cap;
 use pdeshape_core::spectral::SpectralOptions;
 use std::sync::Arc;
 use toml::Spanned;
 
-/// Builds a fill from its edges (each an isoline of a named surface) and options.
+const EDGE_FORMS: &str = "{ surface, s, w } (an isoline), { surface, curve = [s(t), v(t)], t } (a curve in the surface's domain) or { trim = \"PATCH.CURVE\", t } (an earlier patch's trim curve, t in [0, 2π])";
+
+/// Builds a fill from its edges (isolines or curves of named surfaces, trim curves of
+/// earlier patches) and options.
 pub(super) fn build_fill(
     ctx: &Ctx,
     pname: &str,
     key: &str,
     p: &Spanned<RawPatch>,
     surfaces: &[SceneSurface],
+    done: &[ScenePatch],
 ) -> R<ScenePatch> {
     let rp = p.get_ref();
     if let Some(c) = &rp.conditions {
@@ -40,15 +46,44 @@ pub(super) fn build_fill(
     for (i, e) in edges.get_ref().iter().enumerate() {
         let ek = format!("{key}.edges[{i}]");
         let re = e.get_ref();
-        let surf = find_surface(ctx, surfaces, &re.surface, &format!("{ek}.surface"))?;
-        let s0 = ctx.num(re.s.get_ref(), span(&re.s), &format!("{ek}.s"))?;
-        let [w0, w1] = re.w.get_ref();
-        let w = (ctx.num(w0, span(&re.w), &format!("{ek}.w[0]"))?, ctx.num(w1, span(&re.w), &format!("{ek}.w[1]"))?);
+        let range = |x: &Spanned<[NumOrExpr; 2]>, k: &str| -> R<(f64, f64)> {
+            let [a, b] = x.get_ref();
+            Ok((ctx.num(a, span(x), &format!("{ek}.{k}[0]"))?, ctx.num(b, span(x), &format!("{ek}.{k}[1]"))?))
+        };
+        let form = |what: &str| ctx.err(span(e), ek.clone(), format!("{what}; an edge is {EDGE_FORMS}"));
+        let (surface, s0, w): (FieldRef, f64, (f64, f64)) = match (&re.surface, &re.curve, &re.trim) {
+            (Some(name), None, None) => {
+                let (Some(s), Some(w), None) = (&re.s, &re.w, &re.t) else {
+                    return Err(form("an isoline edge takes `s` and `w` (not `t`)"));
+                };
+                let surf = find_surface(ctx, surfaces, name, &format!("{ek}.surface"))?;
+                (surf.field.clone(), ctx.num(s.get_ref(), span(s), &format!("{ek}.s"))?, range(w, "w")?)
+            }
+            (Some(name), Some(curve), None) => {
+                let (None, None, Some(t)) = (&re.s, &re.w, &re.t) else {
+                    return Err(form("a curve edge takes `t` (not `s` or `w`)"));
+                };
+                let surf = find_surface(ctx, surfaces, name, &format!("{ek}.surface"))?;
+                let c = ctx.field2(curve, &["t"], &format!("{ek}.curve"))?;
+                let along =
+                    AlongCurve { host: Host::Field(surf.field.clone()), curve: DomainCurve::Field(Arc::new(c)) };
+                (Arc::new(along), 0.0, range(t, "t")?)
+            }
+            (None, None, Some(trim)) => {
+                let (None, None, Some(t)) = (&re.s, &re.w, &re.t) else {
+                    return Err(form("a trim edge takes `t` (not `s` or `w`)"));
+                };
+                let (patch, curve) = find_trim_curve(ctx, trim, &format!("{ek}.trim"), done)?;
+                let along = AlongCurve { host: Host::Patch(patch), curve: DomainCurve::Trim(curve) };
+                (Arc::new(along), 0.0, range(t, "t")?)
+            }
+            _ => return Err(form("`surface`, `curve` and `trim` do not combine so")),
+        };
         let f = match &re.fullness {
             Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ek}.fullness"))?,
             None => fullness,
         };
-        list.push(FillEdge { surface: surf.field.clone(), s0, w, fullness: f });
+        list.push(FillEdge { surface, s0, w, fullness: f });
     }
     let a = num(&rp.a, "a", 1.0)?;
     let modes = match &rp.modes {

@@ -211,11 +211,17 @@ pub struct RawPatch {
 #[serde(deny_unknown_fields)]
 pub struct RawEdge {
     /// The neighbouring surface (a `[surfaces.NAME]`).
-    pub surface: Spanned<String>,
+    pub surface: Option<Spanned<String>>,
     /// The isoline `s = s₀`.
-    pub s: Spanned<NumOrExpr>,
+    pub s: Option<Spanned<NumOrExpr>>,
     /// The surface's `v` at the edge's start and end, in the loop's direction.
-    pub w: Spanned<[NumOrExpr; 2]>,
+    pub w: Option<Spanned<[NumOrExpr; 2]>>,
+    /// Or a curve `(s(t), v(t))` in the surface's domain.
+    pub curve: Option<Spanned<[NumOrExpr; 2]>>,
+    /// Or a trim curve `"PATCH.CURVE"` of an earlier patch.
+    pub trim: Option<Spanned<String>>,
+    /// The curve's parameter at the edge's start and end (curve and trim edges).
+    pub t: Option<Spanned<[NumOrExpr; 2]>>,
     /// This edge's fullness (overrides the patch's).
     pub fullness: Option<Spanned<NumOrExpr>>,
 }
