@@ -84,20 +84,23 @@ fn surfaces(c: &mut Criterion) {
             grid_mesh(p.as_ref(), &GridOptions::new(200, 200)).expect("finite")
         })
     });
-    // N-sided fill (issue 21 target: fill + 100 × 100 with normals ≤ 2 ms): the sphere
-    // pentagon, from the scene text (parse, expressions, fill, solve) for a new ring length
-    let fill_text = std::fs::read_to_string(
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/fill-sphere-pentagon.toml"),
-    )
-    .unwrap();
-    let mut ring = fresh(0.385673);
-    g.bench_function("fill sphere pentagon: scene + solve (new ring) + 100x100 with normals", |b| {
-        b.iter(|| {
-            let params = std::collections::HashMap::from([("ring".to_string(), ring())]);
-            let s = Scene::parse(&fill_text, "f", "f", &params).unwrap();
-            grid_mesh(s.patches[0].surface.as_ref(), &GridOptions::new(100, 100)).expect("finite")
-        })
-    });
+    // N-sided fills (issue 21 target: fill + 100 × 100 with normals ≤ 2 ms): the three
+    // sphere holes, from the scene text (parse, expressions, fill, solve) for a new ring
+    for hole in ["triangle", "pentagon", "hexagon"] {
+        let fill_text = std::fs::read_to_string(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/fill-sphere-{hole}.toml")),
+        )
+        .unwrap();
+        let ring0 = Scene::parse(&fill_text, "f", "f", &Default::default()).unwrap().params["ring"].value;
+        let mut ring = fresh(ring0);
+        g.bench_function(format!("fill sphere {hole}: scene + solve (new ring) + 100x100 with normals"), |b| {
+            b.iter(|| {
+                let params = std::collections::HashMap::from([("ring".to_string(), ring())]);
+                let s = Scene::parse(&fill_text, "f", "f", &params).unwrap();
+                grid_mesh(s.patches[0].surface.as_ref(), &GridOptions::new(100, 100)).expect("finite")
+            })
+        });
+    }
     g.finish();
 
     // SPEC §10: paper 002 eq. 19 at one t, 100 × 100 points with normals: the closed form
