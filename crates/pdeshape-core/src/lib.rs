@@ -21,6 +21,7 @@ pub mod cancel;
 pub mod data;
 pub mod expr;
 pub mod fill;
+pub mod fit;
 pub mod jet;
 pub mod limits;
 pub mod linalg;

@@ -1,0 +1,173 @@
+//! Clamped B-spline knot vectors and their basis functions with derivatives (the NURBS
+//! Book's `FindSpan`, `BasisFuns` and `DersBasisFuns`, Piegl & Tiller §2.5).
+
+/// A clamped knot vector of degree `p`: `p + 1` equal knots at each end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Knots {
+    /// Degree.
+    pub degree: usize,
+    /// The full knot vector (length `n + p + 1` for `n` control points).
+    pub knots: Vec<f64>,
+}
+
+impl Knots {
+    /// Clamped knots on `[a, b]` with the given interior breakpoints (strictly increasing,
+    /// inside `(a, b)`).
+    pub fn clamped(degree: usize, a: f64, b: f64, interior: &[f64]) -> Knots {
+        let mut knots = vec![a; degree + 1];
+        knots.extend_from_slice(interior);
+        knots.extend(std::iter::repeat_n(b, degree + 1));
+        Knots { degree, knots }
+    }
+
+    /// Uniform clamped knots with `spans` spans on `[a, b]`.
+    pub fn uniform(degree: usize, a: f64, b: f64, spans: usize) -> Knots {
+        let interior: Vec<f64> = (1..spans).map(|i| a + (b - a) * i as f64 / spans as f64).collect();
+        Knots::clamped(degree, a, b, &interior)
+    }
+
+    /// Number of control points.
+    pub fn count(&self) -> usize {
+        self.knots.len() - self.degree - 1
+    }
+
+    /// The distinct breakpoints `a = t₀ < t₁ < … < b`.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = Vec::new();
+        for &t in &self.knots {
+            if b.last() != Some(&t) {
+                b.push(t);
+            }
+        }
+        b
+    }
+
+    /// The Greville abscissae `(t_{j+1} + … + t_{j+p}) / p`, one per control point.
+    pub fn greville(&self) -> Vec<f64> {
+        let p = self.degree;
+        (0..self.count()).map(|j| self.knots[j + 1..=j + p].iter().sum::<f64>() / p as f64).collect()
+    }
+
+    /// The knot span index `i` with `t_i ≤ x < t_{i+1}` (the last non-empty span at `b`).
+    pub fn span(&self, x: f64) -> usize {
+        let (p, n) = (self.degree, self.count());
+        if x >= self.knots[n] {
+            return n - 1;
+        }
+        if x <= self.knots[p] {
+            return p;
+        }
+        // binary search in [p, n)
+        let (mut lo, mut hi) = (p, n);
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if x < self.knots[mid] {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lo
+    }
+
+    /// The `p + 1` non-zero basis functions at `x` and their derivatives up to order `nd`:
+    /// `out[k][r]` is `dᵏ N_{span−p+r}/dxᵏ`; returns the span.
+    pub fn basis(&self, x: f64, nd: usize) -> (usize, Vec<Vec<f64>>) {
+        let p = self.degree;
+        let i = self.span(x);
+        let u = &self.knots;
+        // ndu: basis functions (upper triangle incl. diagonal) and knot differences (lower)
+        let mut ndu = vec![vec![0.0; p + 1]; p + 1];
+        ndu[0][0] = 1.0;
+        let (mut left, mut right) = (vec![0.0; p + 1], vec![0.0; p + 1]);
+        for j in 1..=p {
+            left[j] = x - u[i + 1 - j];
+            right[j] = u[i + j] - x;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        let mut ders = vec![vec![0.0; p + 1]; nd + 1];
+        for j in 0..=p {
+            ders[0][j] = ndu[j][p];
+        }
+        let mut a = vec![vec![0.0; p + 1]; 2];
+        for r in 0..=p {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            a[0][0] = 1.0;
+            for k in 1..=nd.min(p) {
+                let mut d = 0.0;
+                let rk = r as isize - k as isize;
+                let pk = p - k;
+                if r >= k {
+                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                    d = a[s2][0] * ndu[rk as usize][pk];
+                }
+                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                    d += a[s2][k] * ndu[r][pk];
+                }
+                ders[k][r] = d;
+                std::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut f = p as f64;
+        for (k, row) in ders.iter_mut().enumerate().skip(1) {
+            for x in row.iter_mut() {
+                *x *= f;
+            }
+            f *= (p - k) as f64;
+        }
+        (i, ders)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Partition of unity, derivatives summing to 0, and the cubic Bézier case by hand
+    /// (one span: Bernstein polynomials `C(3, r) xʳ (1 − x)³⁻ʳ` and their derivatives).
+    #[test]
+    fn basis_against_bernstein_and_partition_of_unity() {
+        let k = Knots::uniform(3, 0.0, 1.0, 1);
+        for x in [0.0, 0.3, 0.77, 1.0] {
+            let (span, d) = k.basis(x, 2);
+            assert_eq!(span, 3);
+            let b = [(1.0 - x).powi(3), 3.0 * x * (1.0 - x).powi(2), 3.0 * x * x * (1.0 - x), x.powi(3)];
+            let db =
+                [-3.0 * (1.0 - x).powi(2), 3.0 * (1.0 - x) * (1.0 - 3.0 * x), 3.0 * x * (2.0 - 3.0 * x), 3.0 * x * x];
+            let ddb = [6.0 * (1.0 - x), 18.0 * x - 12.0, 6.0 - 18.0 * x, 6.0 * x];
+            for r in 0..4 {
+                assert!((d[0][r] - b[r]).abs() < 1e-15, "{x} {r}");
+                assert!((d[1][r] - db[r]).abs() < 1e-13, "{x} {r}: {} {}", d[1][r], db[r]);
+                assert!((d[2][r] - ddb[r]).abs() < 1e-12, "{x} {r}: {} {}", d[2][r], ddb[r]);
+            }
+        }
+        let k = Knots::clamped(3, 0.0, 2.0, &[0.3, 0.9, 1.2, 1.7]);
+        assert_eq!(k.count(), 8);
+        for x in [0.0, 0.1, 0.3, 0.95, 1.5, 2.0] {
+            let (_, d) = k.basis(x, 3);
+            assert!((d[0].iter().sum::<f64>() - 1.0).abs() < 1e-14);
+            for row in &d[1..] {
+                assert!(row.iter().sum::<f64>().abs() < 1e-11, "{x}: {row:?}");
+            }
+        }
+        assert_eq!(k.span(0.3), 4);
+        assert_eq!(k.span(2.0), 7);
+        let g = k.greville();
+        assert!((g[0] - 0.0).abs() < 1e-15 && (g[7] - 2.0).abs() < 1e-15 && (g[1] - 0.1).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,69 @@
+use super::*;
+use crate::patch::test_shapes::{Paraboloid, Sphere};
+
+/// A deterministic stream of points in `[0, 1) × [a, b)`.
+fn points(n: usize, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> {
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    (0..n).map(move |_| {
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (next(), a + (b - a) * next())
+    })
+}
+
+/// A polynomial patch of degree ≤ 3 in each parameter is reproduced by the first fit (the
+/// interpolant of a cubic is itself), to round-off.
+#[test]
+fn a_paraboloid_is_reproduced_exactly() {
+    let (b, r) = fit_surface(&Paraboloid, &FitOptions { tolerance: Some(1e-12), ..Default::default() }).unwrap();
+    assert_eq!(r.rounds, 1);
+    for (u, v) in points(500, -10.0, 10.0) {
+        let d = (b.point(u, v) - Paraboloid.point(u, v)).norm();
+        // values up to ~100 (v² on [−10, 10]): round-off ~1e-13
+        assert!(d < 1e-12, "({u}, {v}): {d}");
+    }
+}
+
+/// The unit sphere (poles at u = 0 and 1, periodic v): the certified maximum is within the
+/// tolerance, and at 4000 random points — none of them a certificate sample — the deviation
+/// is at most the certified maximum. Corners and the seam are exact.
+#[test]
+fn the_sphere_is_fitted_within_the_certified_tolerance() {
+    let s = Sphere(1.0);
+    for tol in [1e-4, 1e-6, 1e-8] {
+        let (b, r) = fit_surface(&s, &FitOptions { tolerance: Some(tol), ..Default::default() }).unwrap();
+        assert!(r.max_deviation <= tol, "{r:?}");
+        let tau = std::f64::consts::TAU;
+        let mut worst: f64 = 0.0;
+        for (u, v) in points(4000, 0.0, tau) {
+            worst = crate::num::max_nan(worst, (b.point(u, v) - s.point(u, v)).norm());
+        }
+        eprintln!(
+            "sphere at {tol:e}: {:?} control points, certified {:.2e}, random {:.2e}, {} rounds",
+            r.points, r.max_deviation, worst, r.rounds
+        );
+        assert!(worst <= tol, "random points: {worst} > {tol}");
+        // a random point lies on some bump the certificate ascended to its top (to a step
+        // of 1e-6 of the cell, so ~1e-12 relative in value)
+        assert!(worst <= r.max_deviation * (1.0 + 1e-9), "random {worst} above the certificate {}", r.max_deviation);
+        for (u, v) in [(0.0, 0.0), (1.0, 0.0), (0.0, tau), (1.0, tau), (0.5, 0.0)] {
+            assert!((b.point(u, v) - s.point(u, v)).norm() < 1e-14, "({u}, {v})");
+        }
+        for u in [0.1, 0.37, 0.8] {
+            assert!((b.point(u, 0.0) - b.point(u, tau)).norm() < 1e-14, "seam at u = {u}");
+        }
+    }
+}
+
+/// The cap is honoured: an impossible tolerance is an error naming the place.
+#[test]
+fn an_unreachable_tolerance_is_an_error() {
+    let e = fit_surface(&Sphere(1.0), &FitOptions { tolerance: Some(1e-15), max_points: 20, ..Default::default() })
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("was not reached with at most 20 control points"), "{e}");
+}
