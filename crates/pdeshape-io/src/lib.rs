@@ -5,6 +5,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cad;
 pub mod export;
 pub mod model;
 pub mod render;

@@ -38,6 +38,10 @@ enum Command {
         /// Output file or directory.
         #[arg(short, long)]
         out: PathBuf,
+        /// STEP only: the certified maximum deviation of every B-spline face from its patch
+        /// (absolute; default 1e-6 × each patch's bounding-box diagonal).
+        #[arg(long, value_parser = positive)]
+        tolerance: Option<f64>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -405,7 +409,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
     let quiet = cli.quiet;
     let loader = |set, solver, terms: Option<u64>| Load { limits, set, solver, terms: terms.map(|t| t as usize) };
     match cli.command {
-        Command::Build { scene, out, set } => {
+        Command::Build { scene, out, set, tolerance } => {
             let sc = loader(&set, None, None).scene(&scene)?;
             // the condition check runs before anything is written: a scene that fails it
             // leaves no file (quiet: the check alone; otherwise the whole report, printed below)
@@ -423,7 +427,32 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 d
             };
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-            if ext == "png" {
+            if tolerance.is_some() && ext != "step" && ext != "stp" {
+                bail!("--tolerance applies to STEP output only (-o FILE.step)");
+            }
+            if ext == "step" || ext == "stp" {
+                if sc.patches.is_empty() {
+                    bail!("the scene {} has no patches to write", sc.file);
+                }
+                let fitted = pdeshape_io::cad::fit_scene(&sc, tolerance).map_err(|e| anyhow!(e))?;
+                pdeshape_io::cad::write_scene_step(&out, &sc, &fitted)
+                    .with_context(|| format!("cannot write {}", out.display()))?;
+                if !quiet {
+                    for f in &fitted {
+                        let r = &f.report;
+                        eprintln!(
+                            "patch {}: B-spline {} × {} control points, certified deviation {:.2e} ≤ {:.2e}",
+                            f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
+                        );
+                    }
+                    eprintln!(
+                        "wrote {} ({} face{})",
+                        out.display(),
+                        fitted.len(),
+                        if fitted.len() == 1 { "" } else { "s" }
+                    );
+                }
+            } else if ext == "png" {
                 let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
                 write_png(&out, &img)?;
                 if !quiet {
@@ -443,7 +472,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                     );
                 }
             } else if !ext.is_empty() {
-                bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, png, or a directory)");
+                bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, step, png, or a directory)");
             } else {
                 let files = build_into_dir(&sc, &out)?;
                 if !quiet {

@@ -621,6 +621,13 @@ impl Fill {
         &self.report
     }
 
+    /// The corners' `v` inside the loop's period: edge `k` spans `[2πk/N, 2π(k+1)/N]`, and
+    /// across these lines the fill is only C0 (the loop turns at its corners).
+    pub fn corner_parameters(&self) -> Vec<f64> {
+        let n = self.position.pieces.len();
+        (1..n).map(|k| TAU * k as f64 / n as f64).collect()
+    }
+
     /// G1 angle, position gap and curvature gap against the neighbours at `per_edge` points
     /// of every edge (its start corner included), NaN-propagating.
     pub fn edge_continuity(&self, per_edge: usize) -> EdgeContinuity {

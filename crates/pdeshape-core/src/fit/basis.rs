@@ -42,6 +42,21 @@ impl Knots {
         b
     }
 
+    /// The distinct knots with their multiplicities (the form STEP and IGES write).
+    pub fn multiplicities(&self) -> (Vec<f64>, Vec<usize>) {
+        let (mut t, mut m): (Vec<f64>, Vec<usize>) = (Vec::new(), Vec::new());
+        for &x in &self.knots {
+            match t.last() {
+                Some(&y) if y == x => *m.last_mut().expect("paired with t") += 1,
+                _ => {
+                    t.push(x);
+                    m.push(1);
+                }
+            }
+        }
+        (t, m)
+    }
+
     /// The Greville abscissae `(t_{j+1} + … + t_{j+p}) / p`, one per control point.
     pub fn greville(&self) -> Vec<f64> {
         let p = self.degree;

@@ -1,4 +1,5 @@
-//! Mesh exporters (SPEC §8): OBJ, binary PLY, binary STL, glTF 2.0 binary, VTK `.vtu`.
+//! Mesh exporters (SPEC §8): OBJ, binary PLY, binary STL, glTF 2.0 binary, VTK `.vtu`;
+//! and B-spline surface models as STEP.
 //!
 //! Every writer goes through [`write_atomic`]: the file is written to a temporary file in
 //! the target directory and renamed into place, so an interrupted or failed run never
@@ -7,12 +8,14 @@
 mod gltf;
 mod obj;
 mod ply;
+mod step;
 mod stl;
 mod vtu;
 
 pub use gltf::write_glb;
 pub use obj::write_obj;
 pub use ply::write_ply;
+pub use step::{StepFace, write_step};
 pub use stl::write_stl;
 pub use vtu::{write_vtu_hex, write_vtu_surface};
 

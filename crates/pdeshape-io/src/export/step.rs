@@ -1,0 +1,263 @@
+//! STEP (ISO 10303-21) writer for B-spline surface models, application protocol 214
+//! (`AUTOMOTIVE_DESIGN`), the schema every CAD reader takes.
+//!
+//! The file holds one product (`PRODUCT` → `PRODUCT_DEFINITION` → `PRODUCT_DEFINITION_SHAPE`
+//! → `SHAPE_DEFINITION_REPRESENTATION`; without the whole chain some readers import
+//! nothing) whose shape is a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION` holding a
+//! `SHELL_BASED_SURFACE_MODEL`: one `OPEN_SHELL` per face. Each face is an `ADVANCED_FACE`
+//! over a `B_SPLINE_SURFACE_WITH_KNOTS`, bounded by the four boundary isocurves of its
+//! clamped net (exactly its first and last control rows and columns, with the surface's
+//! knots, as `B_SPLINE_CURVE_WITH_KNOTS`):
+//!
+//! - the loop runs counter-clockwise in `(u, v)`: `v = v₀` forward, `u = 1` forward,
+//!   `v = v₁` reversed, `u = 0` reversed, so the face's normal is `S_u × S_v`;
+//! - a boundary row shorter than the uncertainty (a pole) is left out of the loop (a
+//!   degenerate edge has no 3D curve; readers rebuild it from the surface);
+//! - a surface closed in `v` uses one edge for `v = v₀` and `v = v₁` (the seam, once in
+//!   each direction);
+//! - corners closer than the uncertainty share their vertex.
+//!
+//! Lengths are written in millimetres (a scene's unit becomes 1 mm); the uncertainty —
+//! the distance below which two points are one — is the caller's (the fit tolerance).
+
+use pdeshape_core::Vec3;
+use pdeshape_core::fit::{BSplineSurface, Knots};
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+/// A face to write.
+pub struct StepFace<'a> {
+    /// The face's name (the patch's).
+    pub name: &'a str,
+    /// Its surface.
+    pub surface: &'a BSplineSurface,
+}
+
+/// STEP's REAL: shortest round-trip digits with a decimal point and an upper-case exponent.
+fn real(x: f64) -> String {
+    let s = format!("{x:?}");
+    match s.split_once('e') {
+        Some((m, e)) if m.contains('.') => format!("{m}E{e}"),
+        Some((m, e)) => format!("{m}.E{e}"),
+        None if s.contains('.') => s,
+        None => format!("{s}."),
+    }
+}
+
+/// STEP's STRING: apostrophes doubled, only printable ASCII kept (others as `?`; the
+/// names are the scene's, for display only).
+fn string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('\'');
+    for c in s.chars() {
+        match c {
+            '\'' => out.push_str("''"),
+            '\\' => out.push_str("\\\\"),
+            ' '..='~' => out.push(c),
+            _ => out.push('?'),
+        }
+    }
+    out.push('\'');
+    out
+}
+
+/// Entities numbered in order of creation.
+struct Entities {
+    text: String,
+    next: usize,
+}
+
+impl Entities {
+    fn add(&mut self, body: &str) -> usize {
+        self.next += 1;
+        let _ = writeln!(self.text, "#{}={body};", self.next);
+        self.next
+    }
+
+    fn point(&mut self, p: Vec3) -> usize {
+        self.add(&format!("CARTESIAN_POINT('',({},{},{}))", real(p.x), real(p.y), real(p.z)))
+    }
+
+    fn list(ids: impl IntoIterator<Item = usize>) -> String {
+        let v: Vec<String> = ids.into_iter().map(|i| format!("#{i}")).collect();
+        format!("({})", v.join(","))
+    }
+
+    fn knots(k: &Knots) -> (String, String) {
+        let (t, m) = k.multiplicities();
+        let m: Vec<String> = m.iter().map(|x| x.to_string()).collect();
+        let t: Vec<String> = t.iter().map(|&x| real(x)).collect();
+        (format!("({})", m.join(",")), format!("({})", t.join(",")))
+    }
+
+    fn curve(&mut self, pts: &[Vec3], k: &Knots, tol: f64) -> usize {
+        let ids: Vec<usize> = pts.iter().map(|&p| self.point(p)).collect();
+        let (m, t) = Self::knots(k);
+        let closed = if (pts[0] - pts[pts.len() - 1]).norm() <= tol { ".T." } else { ".F." };
+        self.add(&format!(
+            "B_SPLINE_CURVE_WITH_KNOTS('',{},{},.UNSPECIFIED.,{closed},.F.,{m},{t},.UNSPECIFIED.)",
+            k.degree,
+            Self::list(ids)
+        ))
+    }
+
+    fn surface(&mut self, s: &BSplineSurface) -> usize {
+        let (nu, nv) = s.counts();
+        let mut rows = Vec::with_capacity(nu);
+        for i in 0..nu {
+            let ids: Vec<usize> = (0..nv).map(|j| self.point(s.control[i * nv + j])).collect();
+            rows.push(Self::list(ids));
+        }
+        let (mu, tu) = Self::knots(&s.u);
+        let (mv, tv) = Self::knots(&s.v);
+        let vclosed = if s.periodic_v { ".T." } else { ".F." };
+        self.add(&format!(
+            "B_SPLINE_SURFACE_WITH_KNOTS('',{},{},({}),.UNSPECIFIED.,.F.,{vclosed},.F.,{mu},{mv},{tu},{tv},.UNSPECIFIED.)",
+            s.u.degree,
+            s.v.degree,
+            rows.join(",")
+        ))
+    }
+}
+
+/// The length of a polyline of control points (an upper bound of its curve's length).
+fn hull_length(p: &[Vec3]) -> f64 {
+    p.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// Writes one face: surface, boundary edges and vertices, loop; returns its id.
+fn face(e: &mut Entities, f: &StepFace, tol: f64) -> usize {
+    let s = f.surface;
+    let srf = e.surface(s);
+    let (nu, nv) = s.counts();
+    let c = |i: usize, j: usize| s.control[i * nv + j];
+    // corners (0, v₀), (1, v₀), (1, v₁), (0, v₁): a clamped net interpolates them
+    let corners = [c(0, 0), c(nu - 1, 0), c(nu - 1, nv - 1), c(0, nv - 1)];
+    let mut verts: Vec<(Vec3, usize)> = Vec::new();
+    let mut vertex = |e: &mut Entities, p: Vec3| -> usize {
+        if let Some(&(_, id)) = verts.iter().find(|(q, _)| (*q - p).norm() <= tol) {
+            return id;
+        }
+        let pt = e.point(p);
+        let id = e.add(&format!("VERTEX_POINT('',#{pt})"));
+        verts.push((p, id));
+        id
+    };
+    let vid: Vec<usize> = corners.iter().map(|&p| vertex(e, p)).collect();
+    // (curve control points, knots, start corner, end corner, sense in the loop)
+    let sides: [(Vec<Vec3>, &Knots, usize, usize, bool); 4] = [
+        (s.v_edge(false), &s.u, 0, 1, true),
+        (s.u_edge(true), &s.v, 1, 2, true),
+        (s.v_edge(true), &s.u, 3, 2, false),
+        (s.u_edge(false), &s.v, 0, 3, false),
+    ];
+    let mut seam = None;
+    let mut loop_edges = Vec::new();
+    for (k, (pts, knots, a, b, sense)) in sides.iter().enumerate() {
+        if hull_length(pts) <= tol {
+            continue; // a pole: no 3D edge
+        }
+        let edge = match (k, seam) {
+            (2, Some(id)) if s.periodic_v => id,
+            _ => {
+                let curve = e.curve(pts, knots, tol);
+                let id = e.add(&format!("EDGE_CURVE('',#{},#{},#{curve},.T.)", vid[*a], vid[*b]));
+                if k == 0 {
+                    seam = Some(id);
+                }
+                id
+            }
+        };
+        let flag = if *sense { ".T." } else { ".F." };
+        loop_edges.push(e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})")));
+    }
+    let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
+    let bound = e.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"));
+    e.add(&format!("ADVANCED_FACE({},(#{bound}),#{srf},.T.)", string(f.name)))
+}
+
+/// Writes `faces` as one product named `product` (a surface model of open shells, one per
+/// face). `uncertainty` is the distance below which points are one (the fit tolerance).
+/// Refuses non-finite control points.
+pub fn write_step(w: &mut dyn Write, product: &str, faces: &[StepFace], uncertainty: f64) -> io::Result<()> {
+    if let Some(f) = faces.iter().find(|f| f.surface.control.iter().any(|p| !p.is_finite())) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("face `{}` has a non-finite control point", f.name),
+        ));
+    }
+    if !(uncertainty.is_finite() && uncertainty > 0.0) {
+        return Err(io::Error::new(io::ErrorKind::InvalidData, format!("uncertainty {uncertainty} is not positive")));
+    }
+    let mut e = Entities { text: String::new(), next: 0 };
+    let name = string(product);
+    let app = e.add("APPLICATION_CONTEXT('automotive design')");
+    e.add(&format!("APPLICATION_PROTOCOL_DEFINITION('international standard','automotive_design',2000,#{app})"));
+    let pctx = e.add(&format!("PRODUCT_CONTEXT('',#{app},'mechanical')"));
+    let prod = e.add(&format!("PRODUCT({name},{name},'',(#{pctx}))"));
+    e.add(&format!("PRODUCT_RELATED_PRODUCT_CATEGORY('part',$,(#{prod}))"));
+    let form = e.add(&format!("PRODUCT_DEFINITION_FORMATION('','',#{prod})"));
+    let dctx = e.add(&format!("PRODUCT_DEFINITION_CONTEXT('part definition',#{app},'design')"));
+    let pdef = e.add(&format!("PRODUCT_DEFINITION('design','',#{form},#{dctx})"));
+    let pds = e.add(&format!("PRODUCT_DEFINITION_SHAPE('','',#{pdef})"));
+    let length = e.add("(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.))");
+    let angle = e.add("(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.))");
+    let solid = e.add("(NAMED_UNIT(*)SI_UNIT($,.STERADIAN.)SOLID_ANGLE_UNIT())");
+    let unc = e.add(&format!(
+        "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({}),#{length},'distance_accuracy_value','fit tolerance')",
+        real(uncertainty)
+    ));
+    let ctx = e.add(&format!(
+        "(GEOMETRIC_REPRESENTATION_CONTEXT(3)GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#{unc}))GLOBAL_UNIT_ASSIGNED_CONTEXT((#{length},#{angle},#{solid}))REPRESENTATION_CONTEXT('',''))"
+    ));
+    let o = e.point(Vec3::ZERO);
+    let z = e.add("DIRECTION('',(0.,0.,1.))");
+    let x = e.add("DIRECTION('',(1.,0.,0.))");
+    let axes = e.add(&format!("AXIS2_PLACEMENT_3D('',#{o},#{z},#{x})"));
+    let mut shells = Vec::with_capacity(faces.len());
+    for f in faces {
+        let id = face(&mut e, f, uncertainty);
+        shells.push(e.add(&format!("OPEN_SHELL({},(#{id}))", string(f.name))));
+    }
+    let model = e.add(&format!("SHELL_BASED_SURFACE_MODEL('',{})", Entities::list(shells)));
+    let rep = e.add(&format!("MANIFOLD_SURFACE_SHAPE_REPRESENTATION({name},(#{axes},#{model}),#{ctx})"));
+    e.add(&format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+
+    writeln!(w, "ISO-10303-21;")?;
+    writeln!(w, "HEADER;")?;
+    writeln!(w, "FILE_DESCRIPTION(('pdeshape B-spline surface model'),'2;1');")?;
+    writeln!(w, "FILE_NAME({name},'',(''),(''),'pdeshape {}','pdeshape','');", env!("CARGO_PKG_VERSION"))?;
+    writeln!(w, "FILE_SCHEMA(('AUTOMOTIVE_DESIGN {{ 1 0 10303 214 1 1 1 1 }}'));")?;
+    writeln!(w, "ENDSEC;")?;
+    writeln!(w, "DATA;")?;
+    w.write_all(e.text.as_bytes())?;
+    writeln!(w, "ENDSEC;")?;
+    writeln!(w, "END-ISO-10303-21;")?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reals_have_a_point_and_an_upper_case_exponent() {
+        assert_eq!(real(1.0), "1.0");
+        assert_eq!(real(-0.25), "-0.25");
+        assert_eq!(real(1e-7), "1.E-7");
+        assert_eq!(real(1.5e-7), "1.5E-7");
+        assert_eq!(real(2e20), "2.E20");
+        // round trip
+        for x in [0.1, 1.0 / 3.0, -7.123456789e-12, 6.02e23] {
+            let s = real(x).replace('E', "e");
+            assert_eq!(s.parse::<f64>().unwrap(), x);
+        }
+    }
+
+    #[test]
+    fn strings_escape_quotes_and_drop_non_ascii() {
+        assert_eq!(string("fin's"), "'fin''s'");
+        assert_eq!(string("a\\b"), "'a\\\\b'");
+        assert_eq!(string("wing–root"), "'wing?root'");
+    }
+}

@@ -1,0 +1,161 @@
+"""STEP export read back by OpenCASCADE, the independent consumer (run by .ci/run in a venv
+with `cadquery-ocp`).
+
+For each example: `pdeshape build SCENE -o X.step` (the certified fit's figures are read
+from its report), then OCCT's STEPControl_Reader transfers the file, BRepCheck_Analyzer
+judges the shape, and at 1000 random (u, v) per patch the exact point from
+`pdeshape sample` is compared with OCCT's point of the read face at the same (u, v) (that
+distance bounds the distance to the face; GeomAPI_ProjectPointOnSurf confirms it at every
+tenth point): it must be within the tolerance the fit certified.
+
+The CLI binary is $PDESHAPE_BIN, else target/release/pdeshape or target/debug/pdeshape.
+"""
+
+import os
+import re
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from OCP.BRep import BRep_Tool
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.GeomAbs import GeomAbs_BSplineSurface
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+from OCP.gp import gp_Pnt
+
+ROOT = Path(__file__).resolve().parents[4]
+
+# (example, faces, patches with their v domain (start, end)); a few representative kinds:
+# a 4th-order PDE patch through creased polylines (kinks found by the fit), a blend, the
+# 40th-order Klein bottle (closed in v), N-sided fills (C0 corners, a pole)
+CASES = {
+    "four-curve-patch": 1,
+    "bloor-wilson-blend": 1,
+    "klein-bottle": 1,
+    "fill-sphere-pentagon": 1,
+    "fill-wing-root": 1,
+}
+
+REPORT = re.compile(r"patch (\S+): B-spline (\d+) × (\d+) control points, certified deviation (\S+) ≤ (\S+)")
+
+
+def cli():
+    env = os.environ.get("PDESHAPE_BIN")
+    candidates = [Path(env)] if env else [ROOT / "target/release/pdeshape", ROOT / "target/debug/pdeshape"]
+    for c in candidates:
+        if c.is_file():
+            return str(c)
+    pytest.fail(f"no pdeshape binary at {candidates}: run `cargo build` first or set PDESHAPE_BIN")
+
+
+def build(name, tmp_path, *extra):
+    out = tmp_path / f"{name}.step"
+    r = subprocess.run(
+        [cli(), "build", str(ROOT / "examples" / f"{name}.toml"), "-o", str(out), *extra],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    fits = {m[0]: (int(m[1]), int(m[2]), float(m[3]), float(m[4])) for m in REPORT.findall(r.stderr)}
+    return out, fits
+
+
+def read(path):
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone
+    assert reader.TransferRoots() > 0
+    return reader.OneShape()
+
+
+def faces(shape):
+    out = []
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        out.append(TopoDS.Face(ex.Current()))
+        ex.Next()
+    return out
+
+
+def count(shape, kind):
+    ex, n = TopExp_Explorer(shape, kind), 0
+    while ex.More():
+        n += 1
+        ex.Next()
+    return n
+
+
+def sample(name, patch, uv):
+    text = "u,v\n" + "\n".join(f"{float(u)!r},{float(v)!r}" for u, v in uv)
+    r = subprocess.run(
+        [cli(), "sample", str(ROOT / "examples" / f"{name}.toml"), "--patch", patch],
+        input=text,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    rows = np.loadtxt(r.stdout.splitlines()[1:], delimiter=",")
+    return rows[:, 2:5]
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_step_reads_back_valid_and_within_the_certified_tolerance(name, tmp_path):
+    t0 = time.perf_counter()
+    path, fits = build(name, tmp_path)
+    t1 = time.perf_counter()
+    shape = read(path)
+    fs = faces(shape)
+    assert len(fs) == CASES[name] == len(fits), (len(fs), fits)
+    analyzer = BRepCheck_Analyzer(shape)
+    assert analyzer.IsValid(), f"{name}: BRepCheck_Analyzer says invalid"
+    assert count(shape, TopAbs_SHELL) >= 1
+    rng = np.random.default_rng(7)
+    for face, (patch, (nu, nv, deviation, tol)) in zip(fs, fits.items()):
+        assert deviation <= tol
+        adaptor = BRepAdaptor_Surface(face)
+        assert adaptor.GetType() == GeomAbs_BSplineSurface
+        bs = adaptor.BSpline()
+        # a surface closed in v is read as periodic, its repeated seam row dropped
+        assert (bs.NbUPoles(), bs.NbVPoles() + bs.IsVPeriodic()) == (nu, nv)
+        surf = BRep_Tool.Surface_s(face)
+        u0, u1, v0, v1 = surf.Bounds()
+        assert (u0, u1) == (0.0, 1.0)
+        uv = np.column_stack([rng.random(1000), v0 + (v1 - v0) * rng.random(1000)])
+        exact = sample(name, patch, uv)
+        worst = 0.0
+        for k, ((u, v), x) in enumerate(zip(uv, exact)):
+            # the deviation at the same (u, v) (OCCT's evaluation of the read surface)
+            # bounds the distance to the face from above: it is the figure checked at every
+            # point; the projection itself (slow on large nets) at every tenth
+            p = surf.Value(float(u), float(v))
+            d_param = float(np.linalg.norm(np.array([p.X(), p.Y(), p.Z()]) - x))
+            assert not np.isnan(d_param)
+            worst = max(worst, d_param)
+            if k % 10 == 0:
+                proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*map(float, x)), surf)
+                assert proj.NbPoints() > 0
+                assert proj.LowerDistance() <= d_param + 1e-12
+        # the certificate bounds the deviation everywhere, random points included (the
+        # report prints it to 3 digits: 0.5 % rounding)
+        assert worst <= tol, (name, patch, worst, tol)
+        assert worst <= deviation * 1.005, (name, patch, worst, deviation)
+    print(f"{name}: build {t1 - t0:.2f} s, check {time.perf_counter() - t1:.2f} s")
+
+
+def test_a_tighter_tolerance_gives_a_finer_net_still_within_it(tmp_path):
+    _, loose = build("bloor-wilson-blend", tmp_path)
+    path, tight = build("bloor-wilson-blend", tmp_path, "--tolerance", "1e-8")
+    (nu0, nv0, _, _), (nu1, nv1, dev, tol) = loose["blend"], tight["blend"]
+    assert tol == 1e-8 and dev <= 1e-8
+    assert nu1 * nv1 > nu0 * nv0
+    assert BRepCheck_Analyzer(read(path)).IsValid()

@@ -1,0 +1,127 @@
+//! `pdeshape build SCENE -o X.step`: certified B-spline faces in a complete AP214 file.
+//! OpenCASCADE reads these files back in `crates/pdeshape-io/tests/occt` (run by `.ci/run`);
+//! here: the file's structure (every reference defined, the product chain, one face per
+//! patch, the seam and pole edges), the report, and the refusals.
+
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+use std::process::Command;
+
+mod common;
+use common::example;
+
+fn build(scene: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .arg("build")
+        .arg(scene)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// Entities `#n=TYPE(...)` by number, and every `#n` referenced.
+fn entities(text: &str) -> (HashMap<usize, String>, HashSet<usize>) {
+    let data = &text[text.find("DATA;").expect("a DATA section")..];
+    let (mut defs, mut refs) = (HashMap::new(), HashSet::new());
+    for stmt in data.split(";\n").skip(1) {
+        let stmt = stmt.trim();
+        if stmt.is_empty() || stmt.starts_with("ENDSEC") {
+            break;
+        }
+        let (id, body) = stmt.split_once('=').expect("#n=...");
+        let id: usize = id.trim_start_matches('#').parse().expect("a number");
+        let ty: String = body.chars().take_while(|c| *c != '(').collect();
+        assert!(defs.insert(id, if ty.is_empty() { "(complex)".into() } else { ty }).is_none(), "#{id} twice");
+        let mut rest = body;
+        while let Some(k) = rest.find('#') {
+            let digits: String = rest[k + 1..].chars().take_while(|c| c.is_ascii_digit()).collect();
+            refs.insert(digits.parse().expect("a reference"));
+            rest = &rest[k + 1 + digits.len()..];
+        }
+    }
+    (defs, refs)
+}
+
+fn count(defs: &HashMap<usize, String>, ty: &str) -> usize {
+    defs.values().filter(|t| t.as_str() == ty).count()
+}
+
+#[test]
+fn a_fill_is_one_certified_face_in_a_complete_ap214_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pentagon.step");
+    let o = build(&example("fill-sphere-pentagon.toml"), &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    // the report: control points and the certified deviation within the default tolerance
+    let line = err.lines().find(|l| l.starts_with("patch cap: B-spline")).expect("a fit line");
+    let nums: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let (dev, tol) = (nums[nums.len() - 2], nums[nums.len() - 1]);
+    assert!(dev <= tol && tol > 1e-7 && tol < 1e-5, "{line}");
+
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("ISO-10303-21;\nHEADER;"));
+    assert!(text.contains("FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));"));
+    assert!(text.trim_end().ends_with("END-ISO-10303-21;"));
+    let (defs, refs) = entities(&text);
+    for r in &refs {
+        assert!(defs.contains_key(r), "#{r} is referenced but not defined");
+    }
+    // the product chain a CAD reader follows from the product to the geometry
+    for ty in [
+        "PRODUCT",
+        "PRODUCT_DEFINITION_FORMATION",
+        "PRODUCT_DEFINITION",
+        "PRODUCT_DEFINITION_SHAPE",
+        "SHAPE_DEFINITION_REPRESENTATION",
+        "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
+        "SHELL_BASED_SURFACE_MODEL",
+        "OPEN_SHELL",
+        "ADVANCED_FACE",
+        "B_SPLINE_SURFACE_WITH_KNOTS",
+    ] {
+        assert_eq!(count(&defs, ty), 1, "{ty}");
+    }
+    // the fill's loop is closed in v (one seam edge used twice) and ends in a pole (no
+    // edge): a loop of the seam, the rim at u = 0 and the seam back
+    assert_eq!(count(&defs, "EDGE_CURVE"), 2);
+    assert_eq!(count(&defs, "ORIENTED_EDGE"), 3);
+    assert_eq!(count(&defs, "VERTEX_POINT"), 2);
+    assert!(text.contains("UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE("));
+    // the corners of the pentagon are C0 lines of the fill: knots of multiplicity 3 in v
+    let srf = text.lines().find(|l| l.contains("B_SPLINE_SURFACE_WITH_KNOTS")).unwrap();
+    let flags = ".UNSPECIFIED.,.F.,.T.,.F.,(";
+    let rest = &srf[srf.find(flags).expect("closed in v") + flags.len()..];
+    let (_umults, rest) = rest.split_once("),(").unwrap();
+    let vmults: Vec<usize> = rest.split(')').next().unwrap().split(',').map(|m| m.parse().unwrap()).collect();
+    assert_eq!((vmults[0], vmults[vmults.len() - 1]), (4, 4), "clamped");
+    assert_eq!(vmults.iter().filter(|&&m| m == 3).count(), 4, "four interior triple knots in v: {vmults:?}");
+}
+
+#[test]
+fn step_refusals_name_the_cause_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, extra, expect) in [
+        ("trim-circle.toml", vec![], "is trimmed"),
+        ("solid-cubes.toml", vec![], "solid blend"),
+        ("four-curve-patch.toml", vec!["--tolerance", "1e-15"], "was not reached"),
+    ] {
+        let out = dir.path().join("x.step");
+        let o = build(&example(scene), &out, &extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{scene}: {err}");
+        assert!(err.contains(expect) && !err.contains("panicked"), "{scene}: {err}");
+        assert!(!out.exists(), "{scene}: a file was written");
+    }
+    // --tolerance with a mesh format is a mistake, not ignored
+    let out = dir.path().join("x.obj");
+    let o = build(&example("four-curve-patch.toml"), &out, &["--tolerance", "1e-6"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("STEP output only"));
+    assert!(!out.exists());
+}
