@@ -1,22 +1,44 @@
-//! A scene as CAD geometry: every patch fitted by a certified B-spline surface
-//! (`pdeshape_core::fit`) and written as STEP.
+//! A scene as CAD geometry: every patch, and the drawn part of every primary surface,
+//! fitted by a certified B-spline surface (`pdeshape_core::fit`) and written as STEP; the
+//! seams between the fitted faces measured after the fit.
 
 use crate::export::{StepFace, write_atomic, write_step};
 use crate::scene::{Scene, ScenePatch};
+use pdeshape_core::Vec3;
 use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_surface};
+use pdeshape_core::num::max_nan;
+use pdeshape_core::patch::{PrimarySurface, Surface};
 use std::path::Path;
+use std::sync::Arc;
 
-/// One patch as a B-spline surface with its certificate.
-pub struct CadPatch {
-    /// The patch's name.
+/// One face: a patch or a primary surface's drawn part as a B-spline surface with its
+/// certificate.
+pub struct CadFace {
+    /// The patch's name, or `surface-NAME` for a primary surface.
     pub name: String,
     /// The fitted surface.
     pub surface: BSplineSurface,
     /// What the fit achieved (certified maximum deviation, control points).
     pub report: FitReport,
+    /// A primary surface's drawn part (not a patch).
+    pub primary: bool,
 }
 
-/// Why a patch cannot be exported (yet), or its fit failed.
+/// Two fitted faces that meet along a boundary isocurve each (`u = 0` or `1` of both,
+/// with the same `v`): the exported seam's continuity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Seam {
+    /// The faces (indices into the fitted faces) and their boundary `u`.
+    pub faces: [(usize, f64); 2],
+    /// Largest distance between the two faces' boundary points at equal `v`.
+    pub gap: f64,
+    /// Largest angle (radians) between the two faces' normal lines there.
+    pub angle: f64,
+    /// Points compared.
+    pub samples: usize,
+}
+
+/// Why a patch cannot be exported (yet).
 fn exportable(p: &ScenePatch) -> Result<(), String> {
     if p.trim.is_some() {
         return Err(format!(
@@ -30,29 +52,130 @@ fn exportable(p: &ScenePatch) -> Result<(), String> {
     Ok(())
 }
 
-/// Fits every patch of `sc` (dynamic blends at their first time) to `tolerance` (absolute;
-/// `None`: 1e-6 × each patch's bounding-box diagonal). Errors name the patch.
-pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadPatch>, String> {
+/// Fits every patch of `sc` (dynamic blends at their first time), then the drawn part of
+/// every primary surface (`s_range`; at time 0), to `tolerance` (absolute; `None`: 1e-6 ×
+/// each face's bounding-box diagonal). Errors name the patch or surface.
+pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, String> {
     if let Some(t) = tolerance
         && !(t.is_finite() && t > 0.0)
     {
         return Err(format!("tolerance {t} is not a positive number"));
     }
-    let mut out = Vec::with_capacity(sc.patches.len());
+    // faces are named as the mesh exporters name them: `x` for a patch, `surface-x`
+    // (label for errors, face name, surface, C0 lines in v)
+    type Job = (String, String, Arc<dyn Surface>, Vec<f64>);
+    let mut jobs: Vec<Job> = Vec::new();
     for p in &sc.patches {
         exportable(p)?;
         let v_breaks = p.fill.as_ref().map(|f| f.corner_parameters()).unwrap_or_default();
-        let o = FitOptions { tolerance, v_breaks, ..Default::default() };
-        let (surface, report) = fit_surface(p.surface.as_ref(), &o).map_err(|e| format!("patch `{}`: {e}", p.name))?;
-        out.push(CadPatch { name: p.name.clone(), surface, report });
+        jobs.push((format!("patch `{}`", p.name), p.name.clone(), p.surface.clone(), v_breaks));
+    }
+    for s in &sc.surfaces {
+        let Some(range) = s.s_range else { continue };
+        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, 0.0);
+        jobs.push((format!("surface `{}`", s.name), format!("surface-{}", s.name), Arc::new(ps), Vec::new()));
+    }
+    let n_patches = sc.patches.len();
+    let fit = |k: usize, v_start: Vec<f64>| -> Result<CadFace, String> {
+        let (label, name, s, v_breaks) = &jobs[k];
+        let o = FitOptions { tolerance, v_breaks: v_breaks.clone(), v_start, ..Default::default() };
+        let (surface, report) = fit_surface(s.as_ref(), &o).map_err(|e| format!("{label}: {e}"))?;
+        Ok(CadFace { name: name.clone(), surface, report, primary: name.starts_with("surface-") && k >= n_patches })
+    };
+    let mut out = (0..jobs.len()).map(|k| fit(k, Vec::new())).collect::<Result<Vec<_>, _>>()?;
+    // faces that meet along an edge are refitted from the union of their v breakpoints
+    // until they share them (knots only grow, so this ends): their common edge is then
+    // one curve and, with the cross derivatives interpolated at the ends, one tangent plane
+    let mut group: Vec<usize> = (0..out.len()).collect();
+    fn root(g: &mut [usize], mut k: usize) -> usize {
+        while g[k] != k {
+            g[k] = g[g[k]];
+            k = g[k];
+        }
+        k
+    }
+    for s in seams(&out, 9) {
+        let (a, b) = (root(&mut group, s.faces[0].0), root(&mut group, s.faces[1].0));
+        group[a] = b;
+    }
+    for _ in 0..8 {
+        let mut changed = false;
+        for r in 0..out.len() {
+            let members: Vec<usize> = (0..out.len()).filter(|&k| root(&mut group, k) == r).collect();
+            if members.len() < 2 {
+                continue;
+            }
+            let mut union: Vec<f64> = members.iter().flat_map(|&k| out[k].surface.v.breakpoints()).collect();
+            union.sort_by(f64::total_cmp);
+            union.dedup();
+            for &k in &members {
+                if out[k].surface.v.breakpoints() != union {
+                    out[k] = fit(k, union[1..union.len() - 1].to_vec())?;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
     }
     Ok(out)
 }
 
-/// Writes `patches` to `path` as one STEP product named after the scene (atomically); the
+/// The unit normal `S_u × S_v` of a fitted face, or NaN where it degenerates.
+fn normal(b: &BSplineSurface, u: f64, v: f64) -> (Vec3, Vec3) {
+    let d = b.derivatives(u, v, 1, 1);
+    let n = d[2].cross(d[1]);
+    let len = n.norm();
+    (d[0], if len > 0.0 { n * (1.0 / len) } else { Vec3::new(f64::NAN, f64::NAN, f64::NAN) })
+}
+
+/// The seams between fitted faces: boundary isocurves `u = 0 | 1` of two faces that lie
+/// within `10 ×` the larger tolerance of each other at 9 probe values of `v` (same `v`
+/// domain). Each is then measured at `n` values of `v` (pole points, where a normal is
+/// undefined, are left out of the angle).
+pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
+    let mut out = Vec::new();
+    for a in 0..faces.len() {
+        for b in a + 1..faces.len() {
+            let (fa, fb) = (&faces[a].surface, &faces[b].surface);
+            let (da, db) = (fa.v.breakpoints(), fb.v.breakpoints());
+            let (v0, v1) = (da[0], da[da.len() - 1]);
+            if v0 != db[0] || v1 != db[db.len() - 1] {
+                continue;
+            }
+            let tol = 10.0 * faces[a].report.tolerance.max(faces[b].report.tolerance);
+            for ua in [0.0, 1.0] {
+                for ub in [0.0, 1.0] {
+                    let probe = (0..9).all(|k| {
+                        let v = v0 + (v1 - v0) * (k as f64 + 0.5) / 9.0;
+                        (fa.point(ua, v) - fb.point(ub, v)).norm() <= tol
+                    });
+                    if !probe {
+                        continue;
+                    }
+                    let (mut gap, mut angle) = (0.0_f64, 0.0_f64);
+                    for k in 0..n {
+                        let v = v0 + (v1 - v0) * k as f64 / (n - 1).max(1) as f64;
+                        let ((pa, na), (pb, nb)) = (normal(fa, ua, v), normal(fb, ub, v));
+                        gap = max_nan(gap, (pa - pb).norm());
+                        if na.is_finite() && nb.is_finite() {
+                            // normal lines: the faces may be oriented either way
+                            angle = max_nan(angle, na.cross(nb).norm().min(1.0).asin());
+                        }
+                    }
+                    out.push(Seam { faces: [(a, ua), (b, ub)], gap, angle, samples: n });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Writes `faces` to `path` as one STEP product named after the scene (atomically); the
 /// file's uncertainty is the smallest tolerance.
-pub fn write_scene_step(path: &Path, sc: &Scene, patches: &[CadPatch]) -> std::io::Result<()> {
-    let faces: Vec<StepFace> = patches.iter().map(|p| StepFace { name: &p.name, surface: &p.surface }).collect();
-    let unc = patches.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min);
-    write_atomic(path, |w| write_step(w, &sc.name, &faces, unc))
+pub fn write_scene_step(path: &Path, sc: &Scene, faces: &[CadFace]) -> std::io::Result<()> {
+    let fs: Vec<StepFace> = faces.iter().map(|p| StepFace { name: &p.name, surface: &p.surface }).collect();
+    let unc = faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min);
+    write_atomic(path, |w| write_step(w, &sc.name, &fs, unc))
 }

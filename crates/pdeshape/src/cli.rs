@@ -441,8 +441,18 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                     for f in &fitted {
                         let r = &f.report;
                         eprintln!(
-                            "patch {}: B-spline {} × {} control points, certified deviation {:.2e} ≤ {:.2e}",
+                            "face {}: B-spline {} × {} control points, certified deviation {:.3e} ≤ {:.3e}",
                             f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
+                        );
+                    }
+                    for s in pdeshape_io::cad::seams(&fitted, 200) {
+                        let [(a, ua), (b, ub)] = s.faces;
+                        if fitted[a].primary == fitted[b].primary {
+                            continue; // patches between the same surfaces (alternatives)
+                        }
+                        eprintln!(
+                            "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad ({} points, after export)",
+                            fitted[a].name, fitted[b].name, s.gap, s.angle, s.samples
                         );
                     }
                     eprintln!(

@@ -21,7 +21,7 @@ fn build(scene: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-/// Entities `#n=TYPE(...)` by number, and every `#n` referenced.
+/// Entities `#n=TYPE(...)` (their text after `=`) by number, and every `#n` referenced.
 fn entities(text: &str) -> (HashMap<usize, String>, HashSet<usize>) {
     let data = &text[text.find("DATA;").expect("a DATA section")..];
     let (mut defs, mut refs) = (HashMap::new(), HashSet::new());
@@ -32,8 +32,7 @@ fn entities(text: &str) -> (HashMap<usize, String>, HashSet<usize>) {
         }
         let (id, body) = stmt.split_once('=').expect("#n=...");
         let id: usize = id.trim_start_matches('#').parse().expect("a number");
-        let ty: String = body.chars().take_while(|c| *c != '(').collect();
-        assert!(defs.insert(id, if ty.is_empty() { "(complex)".into() } else { ty }).is_none(), "#{id} twice");
+        assert!(defs.insert(id, body.to_string()).is_none(), "#{id} twice");
         let mut rest = body;
         while let Some(k) = rest.find('#') {
             let digits: String = rest[k + 1..].chars().take_while(|c| c.is_ascii_digit()).collect();
@@ -45,7 +44,15 @@ fn entities(text: &str) -> (HashMap<usize, String>, HashSet<usize>) {
 }
 
 fn count(defs: &HashMap<usize, String>, ty: &str) -> usize {
-    defs.values().filter(|t| t.as_str() == ty).count()
+    defs.values().filter(|t| t.starts_with(&format!("{ty}("))).count()
+}
+
+/// The `#n` references in an entity's text, in order.
+fn refs_in(body: &str) -> Vec<usize> {
+    body.split('#')
+        .skip(1)
+        .map(|r| r.chars().take_while(|c| c.is_ascii_digit()).collect::<String>().parse().unwrap())
+        .collect()
 }
 
 #[test]
@@ -56,7 +63,8 @@ fn a_fill_is_one_certified_face_in_a_complete_ap214_file() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
     // the report: control points and the certified deviation within the default tolerance
-    let line = err.lines().find(|l| l.starts_with("patch cap: B-spline")).expect("a fit line");
+    let line = err.lines().find(|l| l.starts_with("face cap: B-spline")).expect("a fit line");
+    assert_eq!(err.lines().filter(|l| l.starts_with("face surface-edge")).count(), 5, "{err}");
     let nums: Vec<f64> = line
         .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
         .filter_map(|w| w.parse().ok())
@@ -81,20 +89,30 @@ fn a_fill_is_one_certified_face_in_a_complete_ap214_file() {
         "SHAPE_DEFINITION_REPRESENTATION",
         "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
         "SHELL_BASED_SURFACE_MODEL",
-        "OPEN_SHELL",
-        "ADVANCED_FACE",
-        "B_SPLINE_SURFACE_WITH_KNOTS",
     ] {
         assert_eq!(count(&defs, ty), 1, "{ty}");
     }
+    // the fill and the five neighbouring surfaces' drawn parts, one open shell each
+    for ty in ["OPEN_SHELL", "ADVANCED_FACE", "B_SPLINE_SURFACE_WITH_KNOTS"] {
+        assert_eq!(count(&defs, ty), 6, "{ty}");
+    }
     // the fill's loop is closed in v (one seam edge used twice) and ends in a pole (no
-    // edge): a loop of the seam, the rim at u = 0 and the seam back
-    assert_eq!(count(&defs, "EDGE_CURVE"), 2);
-    assert_eq!(count(&defs, "ORIENTED_EDGE"), 3);
-    assert_eq!(count(&defs, "VERTEX_POINT"), 2);
+    // edge): the seam (v = v₀) forward, the seam (v = v₁) back, the rim u = 0 reversed
+    let face = defs.values().find(|b| b.starts_with("ADVANCED_FACE('cap',")).expect("the fill's face");
+    let bound = &defs[&refs_in(face)[0]];
+    let lp = &defs[&refs_in(bound)[0]];
+    let oriented: Vec<&String> = refs_in(lp).iter().map(|r| &defs[r]).collect();
+    assert_eq!(oriented.len(), 3, "{lp}");
+    let edges: Vec<usize> = oriented.iter().map(|o| refs_in(o)[0]).collect();
+    assert_eq!(edges[0], edges[1], "the seam, forward and back");
+    assert_ne!(edges[0], edges[2]);
+    assert!(oriented[0].ends_with(".T.)") && oriented[1].ends_with(".F.)") && oriented[2].ends_with(".F.)"));
+    for e in &edges {
+        assert!(defs[e].starts_with("EDGE_CURVE("));
+    }
     assert!(text.contains("UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE("));
     // the corners of the pentagon are C0 lines of the fill: knots of multiplicity 3 in v
-    let srf = text.lines().find(|l| l.contains("B_SPLINE_SURFACE_WITH_KNOTS")).unwrap();
+    let srf = &defs[&refs_in(face)[1]];
     let flags = ".UNSPECIFIED.,.F.,.T.,.F.,(";
     let rest = &srf[srf.find(flags).expect("closed in v") + flags.len()..];
     let (_umults, rest) = rest.split_once("),(").unwrap();

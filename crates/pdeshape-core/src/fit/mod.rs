@@ -6,7 +6,9 @@
 //!
 //! - **Fit**: interpolation at the Greville abscissae, separably — `X` sampled on
 //!   `gᵘ × gᵛ`, then `Bᵤ C = X` per column and `Bᵥ Pᵀ = Cᵀ` per row, `B` the collocation
-//!   matrices (non-singular by Schoenberg–Whitney, well conditioned at Greville points).
+//!   matrices (non-singular by Schoenberg–Whitney, well conditioned at Greville points);
+//!   in `u` the second and last-but-one rows are the cross derivative `X_u` at `u = 0`
+//!   and `1` (clamped-end interpolation), so the edges carry the patch's tangent planes.
 //!   The patch's boundary rows are interpolated at their Greville points too, so corners
 //!   are exact and a periodic `v` closes (positions equal at the seam; the seam's tangent
 //!   continuity is within the tolerance).
@@ -108,11 +110,22 @@ pub struct FitOptions {
     /// Values of `v` where the patch is only C0 (an N-sided fill's corners): knots of full
     /// multiplicity there, so the spline follows the kink exactly.
     pub v_breaks: Vec<f64>,
+    /// Interior `v` breakpoints to start from instead of `spans.1` uniform spans (faces
+    /// that meet along a `u` edge start from the union of each other's, so that they end
+    /// with the same `v` knots and the same edge).
+    pub v_start: Vec<f64>,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
-        FitOptions { tolerance: None, degree: 3, spans: (4, 8), max_points: 400, v_breaks: Vec::new() }
+        FitOptions {
+            tolerance: None,
+            degree: 3,
+            spans: (4, 8),
+            max_points: 400,
+            v_breaks: Vec::new(),
+            v_start: Vec::new(),
+        }
     }
 }
 
@@ -160,16 +173,15 @@ pub enum FitError {
     Singular(String),
 }
 
-/// Solves `B X = R` for the collocation matrix `B[k][j] = N_j(x_k)` and right-hand sides
-/// `R` (rows `k`, `m` columns of `Vec3`).
-fn interpolate(k: &Knots, xs: &[f64], rhs: &[Vec<Vec3>]) -> Result<Vec<Vec<Vec3>>, FitError> {
+/// Solves `B X = R` for the collocation matrix `B[k][j] = N_j^{(d_k)}(x_k)` (rows of values,
+/// `d_k = 0`, or of derivatives) and right-hand sides `R` (rows `k`, `m` columns of `Vec3`).
+fn interpolate(k: &Knots, xs: &[(f64, usize)], rhs: &[Vec<Vec3>]) -> Result<Vec<Vec<Vec3>>, FitError> {
     let n = k.count();
     let m = rhs[0].len();
-    let b = faer::Mat::<f64>::from_fn(n, n, |_, _| 0.0);
-    let mut b = b;
-    for (row, &x) in xs.iter().enumerate() {
-        let (span, d) = k.basis(x, 0);
-        for (r, &w) in d[0].iter().enumerate() {
+    let mut b = faer::Mat::<f64>::from_fn(n, n, |_, _| 0.0);
+    for (row, &(x, order)) in xs.iter().enumerate() {
+        let (span, d) = k.basis(x, order);
+        for (r, &w) in d[order].iter().enumerate() {
             b[(row, span - k.degree + r)] = w;
         }
     }
@@ -193,16 +205,31 @@ fn interpolate(k: &Knots, xs: &[f64], rhs: &[Vec<Vec3>]) -> Result<Vec<Vec<Vec3>
 fn fit_on(s: &dyn Surface, ku: &Knots, kv: &Knots) -> Result<BSplineSurface, FitError> {
     let (gu, gv) = (ku.greville(), kv.greville());
     let g = s.grid(&gu, &gv);
-    let samples: Vec<Vec<Vec3>> = g.chunks(gv.len()).map(|row| row.iter().map(|x| x[0]).collect()).collect();
+    let mut samples: Vec<Vec<Vec3>> = g.chunks(gv.len()).map(|row| row.iter().map(|x| x[0]).collect()).collect();
+    // in u, the rows next to the ends interpolate the cross derivative X_u at u = 0 and 1
+    // instead of X at their Greville points (clamped-end conditions): the face's edge
+    // tangent plane is then the interpolant of the patch's, the same for every face that
+    // meets it along an edge with the same v knots (see `fit_group`)
+    let nu = gu.len();
+    let mut rows: Vec<(f64, usize)> = gu.iter().map(|&u| (u, 0)).collect();
+    if nu >= 4 {
+        let ends = s.grid(&[0.0, 1.0], &gv);
+        let nv = gv.len();
+        rows[1] = (0.0, 1);
+        rows[nu - 2] = (1.0, 1);
+        samples[1] = ends[..nv].iter().map(|x| x[1]).collect();
+        samples[nu - 2] = ends[nv..].iter().map(|x| x[1]).collect();
+    }
     for (i, row) in samples.iter().enumerate() {
         if let Some(j) = row.iter().position(|p| !p.is_finite()) {
-            return Err(FitError::NotFinite(gu[i], gv[j]));
+            return Err(FitError::NotFinite(rows[i].0, gv[j]));
         }
     }
     // along u for every v column, then along v for every u row
-    let c = interpolate(ku, &gu, &samples)?;
+    let c = interpolate(ku, &rows, &samples)?;
     let ct: Vec<Vec<Vec3>> = (0..gv.len()).map(|j| c.iter().map(|row| row[j]).collect()).collect();
-    let pt = interpolate(kv, &gv, &ct)?;
+    let vrows: Vec<(f64, usize)> = gv.iter().map(|&v| (v, 0)).collect();
+    let pt = interpolate(kv, &vrows, &ct)?;
     let (nu, nv) = (ku.count(), kv.count());
     let control = (0..nu * nv).map(|k| pt[k % nv][k / nv]).collect();
     Ok(BSplineSurface { u: ku.clone(), v: kv.clone(), control, periodic_v: s.v_domain().periodic })
@@ -576,6 +603,14 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
     };
     let p = o.degree;
     let mut axes = [Axis::new(0.0, 1.0, o.spans.0, &[]), Axis::new(dom.start, dom.end, o.spans.1, &o.v_breaks)];
+    if !o.v_start.is_empty() {
+        let ax = &mut axes[1];
+        let mut iv: Vec<f64> = o.v_start.iter().copied().filter(|&x| x > ax.lo && x < ax.hi).collect();
+        iv.extend(&ax.c0);
+        iv.sort_by(f64::total_cmp);
+        iv.dedup();
+        ax.interior = iv;
+    }
     let mut samples = 0;
     for round in 1.. {
         let (ku, kv) = (axes[0].knots(p), axes[1].knots(p));
