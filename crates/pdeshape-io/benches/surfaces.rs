@@ -182,10 +182,25 @@ fn evaluate_million(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 18: certified B-spline fitting of a scene's faces (solved patches given; the fit
+/// keeps nothing between iterations), at the default tolerance (1e-6 × each face's
+/// bounding-box diagonal) and at 1e-8 ×.
+fn cad_fit(c: &mut Criterion) {
+    let mut g = c.benchmark_group("cad fit");
+    g.sample_size(10);
+    for name in ["dolphin", "bloor-wilson-blend", "fill-sphere-pentagon"] {
+        let sc = load(&format!("{name}.toml"));
+        g.bench_function(format!("{name}: every face at 1e-6 (certified)"), |b| {
+            b.iter(|| pdeshape_io::cad::fit_scene(&sc, None).unwrap())
+        });
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     // no plots: criterion's plot backend needs system fonts
     config = Criterion::default().without_plots();
-    targets = surfaces, evaluate_million
+    targets = surfaces, evaluate_million, cad_fit
 }
 criterion_main!(benches);

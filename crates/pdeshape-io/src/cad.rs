@@ -5,9 +5,10 @@
 use crate::export::{StepFace, write_atomic, write_step};
 use crate::scene::{Scene, ScenePatch};
 use pdeshape_core::Vec3;
-use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_surface};
+use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_curve, fit_surface};
 use pdeshape_core::num::max_nan;
 use pdeshape_core::patch::{PrimarySurface, Surface};
+use pdeshape_core::trim::TrimCurve;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -22,6 +23,20 @@ pub struct CadFace {
     pub report: FitReport,
     /// A primary surface's drawn part (not a patch).
     pub primary: bool,
+    /// Holes cut by trim curves: inner boundaries of the face.
+    pub holes: Vec<Hole>,
+}
+
+/// A trim curve as an inner boundary: its image on the fitted surface as a space curve.
+pub struct Hole {
+    /// The trim curve's name.
+    pub name: String,
+    /// `S(C(t))`, `t ∈ [0, 2π]`, fitted to the face's tolerance.
+    pub curve: pdeshape_core::fit::BSplineCurve3,
+    /// Its certified deviation from `S(C(t))`.
+    pub deviation: f64,
+    /// The curve runs counter-clockwise in `(u, v)` (the face's inner loop runs it back).
+    pub counter_clockwise: bool,
 }
 
 /// Two fitted faces that meet along a boundary isocurve each (`u = 0` or `1` of both,
@@ -40,12 +55,6 @@ pub struct Seam {
 
 /// Why a patch cannot be exported (yet).
 fn exportable(p: &ScenePatch) -> Result<(), String> {
-    if p.trim.is_some() {
-        return Err(format!(
-            "patch `{}` is trimmed: trimmed faces (B-spline pcurves) are not written to STEP yet; leave the trim out to export the whole patch",
-            p.name
-        ));
-    }
     if p.solid.is_some() {
         return Err(format!("patch `{}` is a solid blend: solids (closed shells) are not written to STEP yet", p.name));
     }
@@ -80,7 +89,7 @@ pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, Str
         let (label, name, s, v_breaks) = &jobs[k];
         let o = FitOptions { tolerance, v_breaks: v_breaks.clone(), v_start, ..Default::default() };
         let (surface, report) = fit_surface(s.as_ref(), &o).map_err(|e| format!("{label}: {e}"))?;
-        Ok(CadFace { name: name.clone(), surface, report, primary: name.starts_with("surface-") && k >= n_patches })
+        Ok(CadFace { name: name.clone(), surface, report, primary: k >= n_patches, holes: Vec::new() })
     };
     let mut out = (0..jobs.len()).map(|k| fit(k, Vec::new())).collect::<Result<Vec<_>, _>>()?;
     // faces that meet along an edge are refitted from the union of their v breakpoints
@@ -98,25 +107,52 @@ pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, Str
         let (a, b) = (root(&mut group, s.faces[0].0), root(&mut group, s.faces[1].0));
         group[a] = b;
     }
-    for _ in 0..8 {
-        let mut changed = false;
-        for r in 0..out.len() {
-            let members: Vec<usize> = (0..out.len()).filter(|&k| root(&mut group, k) == r).collect();
-            if members.len() < 2 {
-                continue;
-            }
-            let mut union: Vec<f64> = members.iter().flat_map(|&k| out[k].surface.v.breakpoints()).collect();
-            union.sort_by(f64::total_cmp);
-            union.dedup();
+    let breaks = |f: &CadFace| f.surface.v.breakpoints();
+    for r in 0..out.len() {
+        let mut members: Vec<usize> = (0..out.len()).filter(|&k| root(&mut group, k) == r).collect();
+        if members.len() < 2 {
+            continue;
+        }
+        // the face that needed the most v knots leads; the others start from the knots so
+        // far, and whoever adds some makes the others refit, until all agree
+        members.sort_by_key(|&k| std::cmp::Reverse(out[k].surface.v.count()));
+        let mut union = breaks(&out[members[0]]);
+        for _ in 0..8 {
+            let mut changed = false;
             for &k in &members {
-                if out[k].surface.v.breakpoints() != union {
+                if breaks(&out[k]) != union {
                     out[k] = fit(k, union[1..union.len() - 1].to_vec())?;
+                    let mut u: Vec<f64> = union.iter().copied().chain(breaks(&out[k])).collect();
+                    u.sort_by(f64::total_cmp);
+                    u.dedup();
+                    union = u;
                     changed = true;
                 }
             }
+            if !changed {
+                break;
+            }
         }
-        if !changed {
-            break;
+    }
+    // trim curves: their images on the final surfaces
+    for (k, p) in sc.patches.iter().enumerate() {
+        let Some(t) = &p.trim else { continue };
+        let region = t.map.region();
+        let f = &mut out[k];
+        for (i, (name, c)) in t.curves.iter().enumerate() {
+            let corners = match c {
+                TrimCurve::Spline(b) if b.degree() == 1 => c.knots(),
+                _ => Vec::new(),
+            };
+            let surface = &f.surface;
+            let image = |t: f64| {
+                let [u, v] = c.point(t);
+                surface.point(u, v)
+            };
+            let (curve, deviation) = fit_curve(&image, 0.0, std::f64::consts::TAU, &corners, f.report.tolerance, 4000)
+                .map_err(|e| format!("patch `{}`, trim curve `{name}`: {e}", p.name))?;
+            let counter_clockwise = region.orientation.get(i).is_none_or(|&o| o > 0.0);
+            f.holes.push(Hole { name: name.clone(), curve, deviation, counter_clockwise });
         }
     }
     Ok(out)
@@ -175,7 +211,14 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
 /// Writes `faces` to `path` as one STEP product named after the scene (atomically); the
 /// file's uncertainty is the smallest tolerance.
 pub fn write_scene_step(path: &Path, sc: &Scene, faces: &[CadFace]) -> std::io::Result<()> {
-    let fs: Vec<StepFace> = faces.iter().map(|p| StepFace { name: &p.name, surface: &p.surface }).collect();
+    let fs: Vec<StepFace> = faces
+        .iter()
+        .map(|p| StepFace {
+            name: &p.name,
+            surface: &p.surface,
+            holes: p.holes.iter().map(|h| (&h.curve, h.counter_clockwise)).collect(),
+        })
+        .collect();
     let unc = faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min);
     write_atomic(path, |w| write_step(w, &sc.name, &fs, unc))
 }

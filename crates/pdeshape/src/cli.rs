@@ -444,11 +444,19 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                             "face {}: B-spline {} × {} control points, certified deviation {:.3e} ≤ {:.3e}",
                             f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
                         );
+                        for h in &f.holes {
+                            eprintln!(
+                                "  hole {}: B-spline curve, {} control points, certified deviation {:.3e} from the face",
+                                h.name,
+                                h.curve.control.len(),
+                                h.deviation
+                            );
+                        }
                     }
                     for s in pdeshape_io::cad::seams(&fitted, 200) {
                         let [(a, ua), (b, ub)] = s.faces;
-                        if fitted[a].primary == fitted[b].primary {
-                            continue; // patches between the same surfaces (alternatives)
+                        if !fitted[a].primary && !fitted[b].primary && ua == ub {
+                            continue; // alternative patches between the same surfaces
                         }
                         eprintln!(
                             "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad ({} points, after export)",

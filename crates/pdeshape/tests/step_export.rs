@@ -125,7 +125,6 @@ fn a_fill_is_one_certified_face_in_a_complete_ap214_file() {
 fn step_refusals_name_the_cause_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, extra, expect) in [
-        ("trim-circle.toml", vec![], "is trimmed"),
         ("solid-cubes.toml", vec![], "solid blend"),
         ("four-curve-patch.toml", vec!["--tolerance", "1e-15"], "was not reached"),
     ] {

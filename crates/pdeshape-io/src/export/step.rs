@@ -15,13 +15,16 @@
 //!   degenerate edge has no 3D curve; readers rebuild it from the surface);
 //! - a surface closed in `v` uses one edge for `v = v₀` and `v = v₁` (the seam, once in
 //!   each direction);
-//! - corners closer than the uncertainty share their vertex.
+//! - corners closer than the uncertainty share their vertex;
+//! - holes (trim curves) are inner `FACE_BOUND`s of one closed edge each, run clockwise
+//!   in `(u, v)`; their 3D curves lie on the written surface (readers compute the
+//!   pcurves by projection).
 //!
 //! Lengths are written in millimetres (a scene's unit becomes 1 mm); the uncertainty —
 //! the distance below which two points are one — is the caller's (the fit tolerance).
 
 use pdeshape_core::Vec3;
-use pdeshape_core::fit::{BSplineSurface, Knots};
+use pdeshape_core::fit::{BSplineCurve3, BSplineSurface, Knots};
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -31,6 +34,9 @@ pub struct StepFace<'a> {
     pub name: &'a str,
     /// Its surface.
     pub surface: &'a BSplineSurface,
+    /// Inner boundaries (holes): closed space curves on the surface, each with whether it
+    /// runs counter-clockwise in the surface's `(u, v)`.
+    pub holes: Vec<(&'a BSplineCurve3, bool)>,
 }
 
 /// STEP's REAL: shortest round-trip digits with a decimal point and an upper-case exponent.
@@ -172,8 +178,18 @@ fn face(e: &mut Entities, f: &StepFace, tol: f64) -> usize {
         loop_edges.push(e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})")));
     }
     let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
-    let bound = e.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"));
-    e.add(&format!("ADVANCED_FACE({},(#{bound}),#{srf},.T.)", string(f.name)))
+    let mut bounds = vec![e.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"))];
+    for (c, ccw) in &f.holes {
+        // one closed edge from and to the curve's start; an inner loop runs clockwise
+        let start = vertex(e, c.control[0]);
+        let curve = e.curve(&c.control, &c.knots, tol);
+        let edge = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
+        let flag = if *ccw { ".F." } else { ".T." };
+        let oe = e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})"));
+        let lp = e.add(&format!("EDGE_LOOP('',(#{oe}))"));
+        bounds.push(e.add(&format!("FACE_BOUND('',#{lp},.T.)")));
+    }
+    e.add(&format!("ADVANCED_FACE({},{},#{srf},.T.)", string(f.name), Entities::list(bounds)))
 }
 
 /// Writes `faces` as one product named `product` (a surface model of open shells, one per

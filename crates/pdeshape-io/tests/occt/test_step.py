@@ -199,3 +199,28 @@ def test_a_c1_blend_stays_g1_with_its_surfaces_after_export(name, patch, u, surf
     pa = np.array([[p.X(), p.Y(), p.Z()] for p in (BRep_Tool.Surface_s(fs[patch]).Value(u, float(v)) for v in vs)])
     pb = np.array([[p.X(), p.Y(), p.Z()] for p in (BRep_Tool.Surface_s(fs[surface]).Value(su, float(v)) for v in vs)])
     assert np.linalg.norm(pa - pb, axis=1).max() <= 1e-12 * (1 + np.abs(pa).max())
+
+
+def test_a_trimmed_patch_is_a_face_with_its_hole(tmp_path):
+    """trim-circle: the patch minus the disc |(u, v) − (0.5, 0.5)| < 0.22 (the scene's
+    defaults). OCCT reads one valid face with an outer and an inner wire; its classifier
+    puts (u, v) inside the disc OUT of the face and points away from it IN."""
+    from OCP.BRepClass import BRepClass_FaceClassifier
+    from OCP.TopAbs import TopAbs_IN, TopAbs_OUT, TopAbs_WIRE
+    from OCP.gp import gp_Pnt2d
+
+    path, fits = build("trim-circle", tmp_path)
+    shape = read(path)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    (face,) = faces(shape)
+    assert count(face, TopAbs_WIRE) == 2
+    rng = np.random.default_rng(3)
+    checked = 0
+    for u, v in rng.random((400, 2)):
+        r = np.hypot(u - 0.5, v - 0.5)
+        if abs(r - 0.22) < 0.01:
+            continue  # near the trim curve
+        state = BRepClass_FaceClassifier(face, gp_Pnt2d(float(u), float(v)), 1e-9).State()
+        assert state == (TopAbs_OUT if r < 0.22 else TopAbs_IN), (u, v, r)
+        checked += 1
+    assert checked > 300
