@@ -65,10 +65,16 @@ fn exportable(p: &ScenePatch) -> Result<(), String> {
 /// every primary surface (`s_range`; at time 0), to `tolerance` (absolute; `None`: 1e-6 ×
 /// each face's bounding-box diagonal). Errors name the patch or surface.
 pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, String> {
-    if let Some(t) = tolerance
-        && !(t.is_finite() && t > 0.0)
-    {
-        return Err(format!("tolerance {t} is not a positive number"));
+    fit_scene_relative(sc, tolerance, 1e-6)
+}
+
+/// [`fit_scene`] with the relative tolerance (× each face's bounding-box diagonal) used
+/// where `tolerance` is `None`.
+pub fn fit_scene_relative(sc: &Scene, tolerance: Option<f64>, relative: f64) -> Result<Vec<CadFace>, String> {
+    for t in tolerance.into_iter().chain([relative]) {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!("tolerance {t} is not a positive number"));
+        }
     }
     // faces are named as the mesh exporters name them: `x` for a patch, `surface-x`
     // (label for errors, face name, surface, C0 lines in v)
@@ -87,7 +93,7 @@ pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, Str
     let n_patches = sc.patches.len();
     let fit = |k: usize, v_start: Vec<f64>| -> Result<CadFace, String> {
         let (label, name, s, v_breaks) = &jobs[k];
-        let o = FitOptions { tolerance, v_breaks: v_breaks.clone(), v_start, ..Default::default() };
+        let o = FitOptions { tolerance, relative, v_breaks: v_breaks.clone(), v_start, ..Default::default() };
         let (surface, report) = fit_surface(s.as_ref(), &o).map_err(|e| format!("{label}: {e}"))?;
         Ok(CadFace { name: name.clone(), surface, report, primary: k >= n_patches, holes: Vec::new() })
     };

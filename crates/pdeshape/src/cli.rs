@@ -40,8 +40,12 @@ enum Command {
         out: PathBuf,
         /// STEP only: the certified maximum deviation of every B-spline face from its patch
         /// (absolute; default 1e-6 × each patch's bounding-box diagonal).
-        #[arg(long, value_parser = positive)]
+        #[arg(long, value_parser = positive, conflicts_with = "relative_tolerance")]
         tolerance: Option<f64>,
+        /// STEP only: the tolerance relative to each patch's bounding-box diagonal
+        /// (default 1e-6).
+        #[arg(long, value_parser = positive)]
+        relative_tolerance: Option<f64>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -409,7 +413,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
     let quiet = cli.quiet;
     let loader = |set, solver, terms: Option<u64>| Load { limits, set, solver, terms: terms.map(|t| t as usize) };
     match cli.command {
-        Command::Build { scene, out, set, tolerance } => {
+        Command::Build { scene, out, set, tolerance, relative_tolerance } => {
             let sc = loader(&set, None, None).scene(&scene)?;
             // the condition check runs before anything is written: a scene that fails it
             // leaves no file (quiet: the check alone; otherwise the whole report, printed below)
@@ -427,14 +431,15 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 d
             };
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-            if tolerance.is_some() && ext != "step" && ext != "stp" {
-                bail!("--tolerance applies to STEP output only (-o FILE.step)");
+            if (tolerance.is_some() || relative_tolerance.is_some()) && ext != "step" && ext != "stp" {
+                bail!("--tolerance and --relative-tolerance apply to STEP output only (-o FILE.step)");
             }
             if ext == "step" || ext == "stp" {
                 if sc.patches.is_empty() {
                     bail!("the scene {} has no patches to write", sc.file);
                 }
-                let fitted = pdeshape_io::cad::fit_scene(&sc, tolerance).map_err(|e| anyhow!(e))?;
+                let fitted = pdeshape_io::cad::fit_scene_relative(&sc, tolerance, relative_tolerance.unwrap_or(1e-6))
+                    .map_err(|e| anyhow!(e))?;
                 pdeshape_io::cad::write_scene_step(&out, &sc, &fitted)
                     .with_context(|| format!("cannot write {}", out.display()))?;
                 if !quiet {

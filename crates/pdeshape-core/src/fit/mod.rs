@@ -100,9 +100,12 @@ impl BSplineSurface {
 /// Options of a fit.
 #[derive(Clone, Debug)]
 pub struct FitOptions {
-    /// Absolute tolerance on the parametric deviation; `None`: 1e-6 × the patch's
+    /// Absolute tolerance on the parametric deviation; `None`: `relative` × the patch's
     /// bounding-box diagonal.
     pub tolerance: Option<f64>,
+    /// The tolerance relative to the patch's bounding-box diagonal when `tolerance` is
+    /// `None` (default 1e-6).
+    pub relative: f64,
     /// Degree in both directions (3, or 5 when C2 must survive).
     pub degree: usize,
     /// Initial spans per direction.
@@ -122,6 +125,7 @@ impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
             tolerance: None,
+            relative: 1e-6,
             degree: 3,
             spans: (4, 8),
             max_points: 400,
@@ -602,7 +606,7 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
                     (lo, hi) = (lo.min(p), hi.max(p));
                 }
             }
-            1e-6 * (hi - lo).norm()
+            o.relative * (hi - lo).norm()
         }
     };
     let p = o.degree;
