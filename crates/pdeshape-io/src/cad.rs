@@ -65,12 +65,18 @@ fn exportable(p: &ScenePatch) -> Result<(), String> {
 /// every primary surface (`s_range`; at time 0), to `tolerance` (absolute; `None`: 1e-6 ×
 /// each face's bounding-box diagonal). Errors name the patch or surface.
 pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, String> {
-    fit_scene_relative(sc, tolerance, 1e-6)
+    fit_scene_relative(sc, tolerance, 1e-6, None)
 }
 
 /// [`fit_scene`] with the relative tolerance (× each face's bounding-box diagonal) used
-/// where `tolerance` is `None`.
-pub fn fit_scene_relative(sc: &Scene, tolerance: Option<f64>, relative: f64) -> Result<Vec<CadFace>, String> {
+/// where `tolerance` is `None`, and dynamic blends (with the primary surfaces) at `time`
+/// (clamped to each blend's range; `None`: the first time).
+pub fn fit_scene_relative(
+    sc: &Scene,
+    tolerance: Option<f64>,
+    relative: f64,
+    time: Option<f64>,
+) -> Result<Vec<CadFace>, String> {
     for t in tolerance.into_iter().chain([relative]) {
         if !(t.is_finite() && t > 0.0) {
             return Err(format!("tolerance {t} is not a positive number"));
@@ -83,11 +89,19 @@ pub fn fit_scene_relative(sc: &Scene, tolerance: Option<f64>, relative: f64) -> 
     for p in &sc.patches {
         exportable(p)?;
         let v_breaks = p.fill.as_ref().map(|f| f.corner_parameters()).unwrap_or_default();
-        jobs.push((format!("patch `{}`", p.name), p.name.clone(), p.surface.clone(), v_breaks));
+        let surface: Arc<dyn Surface> = match (&p.dynamic, time) {
+            (Some(d), Some(t)) => {
+                let t = t.clamp(d.times.0, d.times.1);
+                let f = d.blend.frame(t).map_err(|e| format!("patch `{}` at t = {t}: {e}", p.name))?;
+                Arc::new(f)
+            }
+            _ => p.surface.clone(),
+        };
+        jobs.push((format!("patch `{}`", p.name), p.name.clone(), surface, v_breaks));
     }
     for s in &sc.surfaces {
         let Some(range) = s.s_range else { continue };
-        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, 0.0);
+        let ps = PrimarySurface::new(s.field.clone(), range, s.domain, time.unwrap_or(0.0));
         jobs.push((format!("surface `{}`", s.name), format!("surface-{}", s.name), Arc::new(ps), Vec::new()));
     }
     let n_patches = sc.patches.len();
@@ -214,17 +228,31 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
     out
 }
 
-/// Writes `faces` to `path` as one STEP product named after the scene (atomically); the
-/// file's uncertainty is the smallest tolerance.
-pub fn write_scene_step(path: &Path, sc: &Scene, faces: &[CadFace]) -> std::io::Result<()> {
-    let fs: Vec<StepFace> = faces
+/// `faces` as the bytes of one STEP product named after the scene (the editor's download).
+pub fn step_bytes(sc: &Scene, faces: &[CadFace]) -> std::io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    write_step(&mut out, &sc.name, &step_faces(faces), uncertainty(faces))?;
+    Ok(out)
+}
+
+fn step_faces(faces: &[CadFace]) -> Vec<StepFace<'_>> {
+    faces
         .iter()
         .map(|p| StepFace {
             name: &p.name,
             surface: &p.surface,
             holes: p.holes.iter().map(|h| (&h.curve, h.counter_clockwise)).collect(),
         })
-        .collect();
-    let unc = faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min);
+        .collect()
+}
+
+fn uncertainty(faces: &[CadFace]) -> f64 {
+    faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min)
+}
+
+/// Writes `faces` to `path` as one STEP product named after the scene (atomically); the
+/// file's uncertainty is the smallest tolerance.
+pub fn write_scene_step(path: &Path, sc: &Scene, faces: &[CadFace]) -> std::io::Result<()> {
+    let (fs, unc) = (step_faces(faces), uncertainty(faces));
     write_atomic(path, |w| write_step(w, &sc.name, &fs, unc))
 }

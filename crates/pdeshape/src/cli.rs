@@ -438,8 +438,9 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 if sc.patches.is_empty() {
                     bail!("the scene {} has no patches to write", sc.file);
                 }
-                let fitted = pdeshape_io::cad::fit_scene_relative(&sc, tolerance, relative_tolerance.unwrap_or(1e-6))
-                    .map_err(|e| anyhow!(e))?;
+                let fitted =
+                    pdeshape_io::cad::fit_scene_relative(&sc, tolerance, relative_tolerance.unwrap_or(1e-6), None)
+                        .map_err(|e| anyhow!(e))?;
                 pdeshape_io::cad::write_scene_step(&out, &sc, &fitted)
                     .with_context(|| format!("cannot write {}", out.display()))?;
                 if !quiet {

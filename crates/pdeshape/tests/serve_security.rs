@@ -112,6 +112,35 @@ fn export_never_writes_a_path_from_the_request() {
     }
 }
 
+/// The editor's STEP download: certified B-spline faces of the model at the editor's
+/// time (a dynamic blend's frame), with the scene's sanitised name; an unknown format is
+/// refused.
+#[test]
+fn export_offers_step_at_the_editors_time() {
+    let (_k, addr) = start(&[]);
+    let text = scene("dynamic-elliptic-cylinders.toml");
+    let mut bodies = Vec::new();
+    for time in [0.0, 0.6] {
+        let a = post_json(
+            &addr,
+            "/api/export?format=step",
+            &serde_json::json!({"text": text, "name": "dyn", "time": time}),
+        );
+        assert_eq!(a.status, 200, "{}", a.text());
+        let t = a.text();
+        assert!(t.starts_with("ISO-10303-21;") && t.trim_end().ends_with("END-ISO-10303-21;"), "{}", &t[..80]);
+        // the blend and the two drawn primary surfaces
+        assert_eq!(t.matches("=ADVANCED_FACE(").count(), 3, "{t}");
+        let cd = a.headers.lines().find(|l| l.to_ascii_lowercase().starts_with("content-disposition")).unwrap();
+        assert!(cd.contains("filename=\"dyn.step\""), "{cd}");
+        bodies.push(t.to_string());
+    }
+    assert_ne!(bodies[0], bodies[1], "the frame at t = 0.6 is not the first");
+    let a = post_json(&addr, "/api/export?format=iges", &serde_json::json!({"text": text}));
+    assert_eq!(a.status, 400);
+    assert!(a.text().contains("known: obj, ply, stl, glb, vtu, step"), "{}", a.text());
+}
+
 /// DNS rebinding: a page on attacker.example resolving to 127.0.0.1 sends `Host:
 /// attacker.example:PORT`; such requests are refused (421) before any work.
 #[test]

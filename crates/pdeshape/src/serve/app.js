@@ -555,7 +555,7 @@ function buildPanel(h) {
   } else { $("timebox").style.display = "none"; time = null; }
   $("trimbox").style.display = h.patches.some((p) => p.trim) ? "block" : "none";
   const dl = $("downloads"); dl.innerHTML = "";
-  for (const f of ["obj", "ply", "stl", "glb", "vtu"]) {
+  for (const f of ["obj", "ply", "stl", "glb", "vtu", "step"]) {
     const b = document.createElement("button"); b.textContent = f.toUpperCase(); b.dataset.format = f;
     b.onclick = () => download(f); dl.appendChild(b);
   }

@@ -479,17 +479,30 @@ async fn export_route(
     Json(req): Json<ModelRequest>,
 ) -> Response {
     let arrived = Instant::now();
-    let Some(format) = pdeshape_io::export::Format::from_extension(&q.format) else {
+    let step = q.format == "step";
+    let format = pdeshape_io::export::Format::from_extension(&q.format);
+    if format.is_none() && !step {
         return fail(
             StatusCode::BAD_REQUEST,
-            format!("unknown format `{}` (known: obj, ply, stl, glb, vtu)", clip(&q.format, 16)),
+            format!("unknown format `{}` (known: obj, ply, stl, glb, vtu, step)", clip(&q.format, 16)),
         );
-    };
+    }
+    let extension = format.map_or("step", |f| f.extension());
     let limits = s.limits;
     let r = limited(&s, arrived, move || {
         let (scene, _, meshes) = solve(&req, &limits)?;
-        let refs: Vec<&Mesh> = meshes.iter().collect();
-        let bytes = pdeshape_io::export::to_bytes(format, &refs).map_err(|e| e.to_string())?;
+        let bytes = match format {
+            Some(format) => {
+                let refs: Vec<&Mesh> = meshes.iter().collect();
+                pdeshape_io::export::to_bytes(format, &refs).map_err(|e| e.to_string())?
+            }
+            // certified B-spline faces at the editor's time (inside the time limit: the
+            // fit checks the cancel flag)
+            None => {
+                let faces = pdeshape_io::cad::fit_scene_relative(&scene, None, 1e-6, req.time)?;
+                pdeshape_io::cad::step_bytes(&scene, &faces).map_err(|e| e.to_string())?
+            }
+        };
         Ok((scene.name, bytes))
     })
     .await;
@@ -498,7 +511,7 @@ async fn export_route(
             [
                 (header::CONTENT_TYPE, "application/octet-stream".to_string()),
                 // `name` went through safe_name: no quote, slash or control character
-                (header::CONTENT_DISPOSITION, format!("attachment; filename=\"{name}.{}\"", format.extension())),
+                (header::CONTENT_DISPOSITION, format!("attachment; filename=\"{name}.{extension}\"")),
             ],
             bytes,
         )
