@@ -60,6 +60,10 @@ enum Command {
         /// Solver for blends: auto, exact or collocation (overrides the scene).
         #[arg(long)]
         solver: Option<String>,
+        /// Also fit the faces a STEP export would write and report each face's certified
+        /// deviation and control points, and each seam's gap and angle after the fit.
+        #[arg(long)]
+        cad: bool,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -444,30 +448,8 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 pdeshape_io::cad::write_scene_step(&out, &sc, &fitted)
                     .with_context(|| format!("cannot write {}", out.display()))?;
                 if !quiet {
-                    for f in &fitted {
-                        let r = &f.report;
-                        eprintln!(
-                            "face {}: B-spline {} × {} control points, certified deviation {:.3e} ≤ {:.3e}",
-                            f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
-                        );
-                        for h in &f.holes {
-                            eprintln!(
-                                "  hole {}: B-spline curve, {} control points, certified deviation {:.3e} from the face",
-                                h.name,
-                                h.curve.control.len(),
-                                h.deviation
-                            );
-                        }
-                    }
-                    for s in pdeshape_io::cad::seams(&fitted, 200) {
-                        let [(a, ua), (b, ub)] = s.faces;
-                        if !fitted[a].primary && !fitted[b].primary && ua == ub {
-                            continue; // alternative patches between the same surfaces
-                        }
-                        eprintln!(
-                            "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad ({} points, after export)",
-                            fitted[a].name, fitted[b].name, s.gap, s.angle, s.samples
-                        );
+                    for line in cad_lines(&fitted) {
+                        eprintln!("{line}");
                     }
                     eprintln!(
                         "wrote {} ({} face{})",
@@ -521,13 +503,23 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             }
             Ok(())
         }
-        Command::Check { scene, json, set, solver } => {
+        Command::Check { scene, json, set, solver, cad } => {
             let sc = loader(&set, solver.as_deref(), None).scene(&scene)?;
-            let d = model::scene_diagnostics(&sc);
+            let mut d = model::scene_diagnostics(&sc);
+            let fitted = if cad { Some(pdeshape_io::cad::fit_scene(&sc, None).map_err(|e| anyhow!(e))?) } else { None };
+            if let Some(f) = &fitted {
+                d["cad"] = cad_report(f);
+            }
             if json {
                 println!("{}", serde_json::to_string_pretty(&d)?);
             } else {
                 print_check(&sc, &d);
+                if let Some(f) = &fitted {
+                    println!("  CAD (STEP) faces:");
+                    for line in cad_lines(f) {
+                        println!("    {line}");
+                    }
+                }
             }
             check_finite_report(&d)
         }
@@ -697,6 +689,85 @@ fn print_check(sc: &Scene, d: &serde_json::Value) {
             println!("      warning: {}", w.as_str().unwrap_or(""));
         }
     }
+}
+
+/// The figures of a scene's CAD fit, one line each: faces (net, certified deviation,
+/// holes) and seams (gap and normal angle after the fit).
+fn cad_lines(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<String> {
+    let mut out = Vec::new();
+    for f in fitted {
+        let r = &f.report;
+        out.push(format!(
+            "face {}: B-spline {} × {} control points, certified deviation {:.3e} ≤ {:.3e}",
+            f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
+        ));
+        for h in &f.holes {
+            out.push(format!(
+                "  hole {}: B-spline curve, {} control points, certified deviation {:.3e} from the face",
+                h.name,
+                h.curve.control.len(),
+                h.deviation
+            ));
+        }
+    }
+    for s in cad_seams(fitted) {
+        let [(a, ua), (b, ub)] = s.faces;
+        out.push(format!(
+            "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad ({} points, after export)",
+            fitted[a].name, fitted[b].name, s.gap, s.angle, s.samples
+        ));
+    }
+    out
+}
+
+/// Seams between fitted faces, without those between alternative patches that join the
+/// same surfaces (both patches, the same boundary).
+fn cad_seams(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<pdeshape_io::cad::Seam> {
+    pdeshape_io::cad::seams(fitted, 200)
+        .into_iter()
+        .filter(|s| {
+            let [(a, ua), (b, ub)] = s.faces;
+            fitted[a].primary || fitted[b].primary || ua != ub
+        })
+        .collect()
+}
+
+/// The CAD fit as JSON for `check --json --cad`.
+fn cad_report(fitted: &[pdeshape_io::cad::CadFace]) -> serde_json::Value {
+    let faces: Vec<serde_json::Value> = fitted
+        .iter()
+        .map(|f| {
+            let r = &f.report;
+            let holes: Vec<serde_json::Value> = f
+                .holes
+                .iter()
+                .map(|h| {
+                    serde_json::json!({
+                        "name": h.name, "control_points": h.curve.control.len(), "certified_deviation": h.deviation,
+                    })
+                })
+                .collect();
+            serde_json::json!({
+                "name": f.name,
+                "primary": f.primary,
+                "control_points": [r.points.0, r.points.1],
+                "tolerance": r.tolerance,
+                "certified_deviation": r.max_deviation,
+                "holes": holes,
+            })
+        })
+        .collect();
+    let seams: Vec<serde_json::Value> = cad_seams(fitted)
+        .iter()
+        .map(|s| {
+            let [(a, ua), (b, ub)] = s.faces;
+            serde_json::json!({
+                "faces": [fitted[a].name, fitted[b].name], "u": [ua, ub],
+                "gap": s.gap, "normal_angle_radians": s.angle, "samples": s.samples,
+            })
+        })
+        .collect();
+    serde_json::json!({ "faces": faces, "seams": seams })
 }
 
 /// Reads CSV rows of `N` finite numbers from stdin and writes `header` then one line per
