@@ -171,3 +171,25 @@ fn check_reports_the_fit_and_the_seams_after_export() {
         assert!(gap <= 1e-13 && angle <= 1e-12, "{s}");
     }
 }
+
+/// The Bloor–Wilson blend and its cylinder and plane are one open shell: the seams are
+/// single edges used by both faces (3 seam edges of the closed faces, 2 rims, 2 shared
+/// trimlines: 7 edges where unshared faces would have 9), and the cylinder is flipped so
+/// that its shared edge runs against the blend's (OCCT confirms the orientation in
+/// `crates/pdeshape-io/tests/occt`).
+#[test]
+fn a_blend_and_its_surfaces_are_one_shell() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bw.step");
+    let o = build(&example("bloor-wilson-blend.toml"), &out, &["-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let (defs, _) = entities(&text);
+    assert_eq!(count(&defs, "OPEN_SHELL"), 1);
+    assert_eq!(count(&defs, "ADVANCED_FACE"), 3);
+    assert_eq!(count(&defs, "EDGE_CURVE"), 7);
+    let flipped: Vec<&String> =
+        defs.values().filter(|b| b.starts_with("ADVANCED_FACE(") && b.ends_with(",.F.)")).collect();
+    assert_eq!(flipped.len(), 1, "{flipped:?}");
+    assert!(flipped[0].starts_with("ADVANCED_FACE('surface-cylinder',"), "{}", flipped[0]);
+}

@@ -4,7 +4,10 @@
 //! The file holds one product (`PRODUCT` → `PRODUCT_DEFINITION` → `PRODUCT_DEFINITION_SHAPE`
 //! → `SHAPE_DEFINITION_REPRESENTATION`; without the whole chain some readers import
 //! nothing) whose shape is a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION` holding a
-//! `SHELL_BASED_SURFACE_MODEL`: one `OPEN_SHELL` per face. Each face is an `ADVANCED_FACE`
+//! `SHELL_BASED_SURFACE_MODEL`: one `OPEN_SHELL` per set of faces joined by shared edges
+//! (boundary curves with the same knots and control points within the uncertainty — faces
+//! fitted with common knots along a common edge — are one `EDGE_CURVE`; faces are flipped
+//! where needed so that the two faces of a shared edge run it in opposite directions). Each face is an `ADVANCED_FACE`
 //! over a `B_SPLINE_SURFACE_WITH_KNOTS`, bounded by the four boundary isocurves of its
 //! clamped net (exactly its first and last control rows and columns, with the surface's
 //! knots, as `B_SPLINE_CURVE_WITH_KNOTS`):
@@ -131,14 +134,117 @@ fn hull_length(p: &[Vec3]) -> f64 {
     p.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
-/// Writes one face: surface, boundary edges and vertices, loop; returns its id.
-fn face(e: &mut Entities, f: &StepFace, tol: f64) -> usize {
-    let s = f.surface;
-    let srf = e.surface(s);
+/// A boundary side of a face: its curve (control points and knots), the corners it joins
+/// (indices into the face's corners) and its direction in the face's loop.
+struct Side<'a> {
+    pts: Vec<Vec3>,
+    knots: &'a Knots,
+    from: usize,
+    to: usize,
+    forward: bool,
+}
+
+/// The sides of a face's outer loop, counter-clockwise in `(u, v)`, without poles; a
+/// surface closed in `v` has its seam (`v = v₀` and `v = v₁`) as side 0 and side 2.
+fn sides<'a>(s: &'a BSplineSurface, tol: f64) -> Vec<(usize, Side<'a>)> {
+    let all = [
+        Side { pts: s.v_edge(false), knots: &s.u, from: 0, to: 1, forward: true },
+        Side { pts: s.u_edge(true), knots: &s.v, from: 1, to: 2, forward: true },
+        Side { pts: s.v_edge(true), knots: &s.u, from: 3, to: 2, forward: false },
+        Side { pts: s.u_edge(false), knots: &s.v, from: 0, to: 3, forward: false },
+    ];
+    all.into_iter().enumerate().filter(|(_, side)| hull_length(&side.pts) > tol).collect()
+}
+
+/// The corners `(0, v₀), (1, v₀), (1, v₁), (0, v₁)` (a clamped net interpolates them).
+fn corners(s: &BSplineSurface) -> [Vec3; 4] {
     let (nu, nv) = s.counts();
     let c = |i: usize, j: usize| s.control[i * nv + j];
-    // corners (0, v₀), (1, v₀), (1, v₁), (0, v₁): a clamped net interpolates them
-    let corners = [c(0, 0), c(nu - 1, 0), c(nu - 1, nv - 1), c(0, nv - 1)];
+    [c(0, 0), c(nu - 1, 0), c(nu - 1, nv - 1), c(0, nv - 1)]
+}
+
+/// The shell's topology: edges shared by faces whose boundary curves coincide (same knots,
+/// control points within the uncertainty: faces fitted with common knots along a common
+/// edge), and which faces to flip so that every shared edge is run in opposite directions
+/// by its two faces (a consistently oriented shell).
+struct Topology {
+    /// Per face and side: the index of its edge in `edges`.
+    edge_of: Vec<Vec<(usize, usize)>>,
+    /// Edges: (face, side) that defines the curve.
+    edges: Vec<(usize, usize)>,
+    /// Faces to write with `same_sense` false.
+    flip: Vec<bool>,
+    /// Connected components (one open shell each).
+    shells: Vec<Vec<usize>>,
+}
+
+fn topology(faces: &[StepFace], tol: f64) -> Topology {
+    let sides: Vec<Vec<(usize, Side)>> = faces.iter().map(|f| sides(f.surface, tol)).collect();
+    let mut edges: Vec<(usize, usize)> = Vec::new();
+    let mut edge_of: Vec<Vec<(usize, usize)>> = Vec::with_capacity(faces.len());
+    // uses[e]: (face, runs forward)
+    let mut uses: Vec<Vec<(usize, bool)>> = Vec::new();
+    for (fi, f) in faces.iter().enumerate() {
+        let mut mine = Vec::new();
+        for (k, side) in &sides[fi] {
+            let own_seam = *k == 2 && f.surface.periodic_v;
+            let found = if own_seam {
+                mine.iter().find(|(kk, _)| *kk == 0).map(|&(_, e)| e)
+            } else {
+                // an edge joins at most two faces (a manifold shell): a third gets its own
+                edges.iter().enumerate().position(|(ei, &(g, gk))| {
+                    let other = &sides[g].iter().find(|(k2, _)| *k2 == gk).expect("registered").1;
+                    g != fi
+                        && uses[ei].len() == 1
+                        && other.knots == side.knots
+                        && other.pts.len() == side.pts.len()
+                        && other.pts.iter().zip(&side.pts).all(|(a, b)| (*a - *b).norm() <= tol)
+                })
+            };
+            let e = found.unwrap_or_else(|| {
+                edges.push((fi, *k));
+                uses.push(Vec::new());
+                edges.len() - 1
+            });
+            uses[e].push((fi, side.forward));
+            mine.push((*k, e));
+        }
+        edge_of.push(mine);
+    }
+    // flips by a walk over faces joined by shared edges
+    let n = faces.len();
+    let (mut flip, mut seen) = (vec![false; n], vec![false; n]);
+    let mut shells = Vec::new();
+    for start in 0..n {
+        if seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        let (mut stack, mut comp) = (vec![start], vec![start]);
+        while let Some(f) = stack.pop() {
+            for &(_, e) in &edge_of[f] {
+                let here = uses[e].iter().find(|(g, _)| *g == f).map(|u| u.1);
+                for &(g, dir) in &uses[e] {
+                    if g == f || seen[g] {
+                        continue;
+                    }
+                    // opposite directions after the flips: flip_g = flip_f xor (dir_f == dir_g)
+                    flip[g] = flip[f] ^ (here == Some(dir));
+                    seen[g] = true;
+                    stack.push(g);
+                    comp.push(g);
+                }
+            }
+        }
+        comp.sort_unstable();
+        shells.push(comp);
+    }
+    Topology { edge_of, edges, flip, shells }
+}
+
+/// Writes the faces' vertices and edges (shared ones once) and the faces; returns the
+/// face ids.
+fn write_faces(e: &mut Entities, faces: &[StepFace], t: &Topology, tol: f64) -> Vec<usize> {
     let mut verts: Vec<(Vec3, usize)> = Vec::new();
     let mut vertex = |e: &mut Entities, p: Vec3| -> usize {
         if let Some(&(_, id)) = verts.iter().find(|(q, _)| (*q - p).norm() <= tol) {
@@ -149,47 +255,51 @@ fn face(e: &mut Entities, f: &StepFace, tol: f64) -> usize {
         verts.push((p, id));
         id
     };
-    let vid: Vec<usize> = corners.iter().map(|&p| vertex(e, p)).collect();
-    // (curve control points, knots, start corner, end corner, sense in the loop)
-    let sides: [(Vec<Vec3>, &Knots, usize, usize, bool); 4] = [
-        (s.v_edge(false), &s.u, 0, 1, true),
-        (s.u_edge(true), &s.v, 1, 2, true),
-        (s.v_edge(true), &s.u, 3, 2, false),
-        (s.u_edge(false), &s.v, 0, 3, false),
-    ];
-    let mut seam = None;
-    let mut loop_edges = Vec::new();
-    for (k, (pts, knots, a, b, sense)) in sides.iter().enumerate() {
-        if hull_length(pts) <= tol {
-            continue; // a pole: no 3D edge
-        }
-        let edge = match (k, seam) {
-            (2, Some(id)) if s.periodic_v => id,
-            _ => {
-                let curve = e.curve(pts, knots, tol);
-                let id = e.add(&format!("EDGE_CURVE('',#{},#{},#{curve},.T.)", vid[*a], vid[*b]));
-                if k == 0 {
-                    seam = Some(id);
+    let mut edge_ids: Vec<Option<usize>> = vec![None; t.edges.len()];
+    let mut out = Vec::with_capacity(faces.len());
+    for (fi, f) in faces.iter().enumerate() {
+        let s = f.surface;
+        let srf = e.surface(s);
+        let cs = corners(s);
+        let sd = sides(s, tol);
+        let mut loop_edges = Vec::new();
+        for (k, side) in &sd {
+            let ei = t.edge_of[fi].iter().find(|(kk, _)| kk == k).expect("every side has an edge").1;
+            let id = match edge_ids[ei] {
+                Some(id) => id,
+                None => {
+                    let (a, b) = (vertex(e, cs[side.from]), vertex(e, cs[side.to]));
+                    let curve = e.curve(&side.pts, side.knots, tol);
+                    let id = e.add(&format!("EDGE_CURVE('',#{a},#{b},#{curve},.T.)"));
+                    edge_ids[ei] = Some(id);
+                    id
                 }
-                id
-            }
-        };
-        let flag = if *sense { ".T." } else { ".F." };
-        loop_edges.push(e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})")));
+            };
+            let flag = if side.forward { ".T." } else { ".F." };
+            loop_edges.push(e.add(&format!("ORIENTED_EDGE('',*,*,#{id},{flag})")));
+        }
+        // a flipped face (normal −S_u × S_v) runs its loops the other way round
+        let sense = |b: bool| if b != t.flip[fi] { ".T." } else { ".F." };
+        let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
+        let mut bounds = vec![e.add(&format!("FACE_OUTER_BOUND('',#{lp},{})", sense(true)))];
+        for (c, ccw) in &f.holes {
+            // one closed edge from and to the curve's start; an inner loop runs clockwise
+            let start = vertex(e, c.control[0]);
+            let curve = e.curve(&c.control, &c.knots, tol);
+            let edge = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
+            let flag = if *ccw { ".F." } else { ".T." };
+            let oe = e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})"));
+            let lp = e.add(&format!("EDGE_LOOP('',(#{oe}))"));
+            bounds.push(e.add(&format!("FACE_BOUND('',#{lp},{})", sense(true))));
+        }
+        out.push(e.add(&format!(
+            "ADVANCED_FACE({},{},#{srf},{})",
+            string(f.name),
+            Entities::list(bounds),
+            sense(true)
+        )));
     }
-    let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
-    let mut bounds = vec![e.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"))];
-    for (c, ccw) in &f.holes {
-        // one closed edge from and to the curve's start; an inner loop runs clockwise
-        let start = vertex(e, c.control[0]);
-        let curve = e.curve(&c.control, &c.knots, tol);
-        let edge = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
-        let flag = if *ccw { ".F." } else { ".T." };
-        let oe = e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})"));
-        let lp = e.add(&format!("EDGE_LOOP('',(#{oe}))"));
-        bounds.push(e.add(&format!("FACE_BOUND('',#{lp},.T.)")));
-    }
-    e.add(&format!("ADVANCED_FACE({},{},#{srf},.T.)", string(f.name), Entities::list(bounds)))
+    out
 }
 
 /// Writes `faces` as one product named `product` (a surface model of open shells, one per
@@ -230,10 +340,16 @@ pub fn write_step(w: &mut dyn Write, product: &str, faces: &[StepFace], uncertai
     let z = e.add("DIRECTION('',(0.,0.,1.))");
     let x = e.add("DIRECTION('',(1.,0.,0.))");
     let axes = e.add(&format!("AXIS2_PLACEMENT_3D('',#{o},#{z},#{x})"));
-    let mut shells = Vec::with_capacity(faces.len());
-    for f in faces {
-        let id = face(&mut e, f, uncertainty);
-        shells.push(e.add(&format!("OPEN_SHELL({},(#{id}))", string(f.name))));
+    let topo = topology(faces, uncertainty);
+    let ids = write_faces(&mut e, faces, &topo, uncertainty);
+    let mut shells = Vec::with_capacity(topo.shells.len());
+    for comp in &topo.shells {
+        let names: Vec<&str> = comp.iter().map(|&k| faces[k].name).collect();
+        shells.push(e.add(&format!(
+            "OPEN_SHELL({},{})",
+            string(&names.join("+")),
+            Entities::list(comp.iter().map(|&k| ids[k]))
+        )));
     }
     let model = e.add(&format!("SHELL_BASED_SURFACE_MODEL('',{})", Entities::list(shells)));
     let rep = e.add(&format!("MANIFOLD_SURFACE_SHAPE_REPRESENTATION({name},(#{axes},#{model}),#{ctx})"));

@@ -189,7 +189,10 @@ def test_a_c1_blend_stays_g1_with_its_surfaces_after_export(name, patch, u, surf
     same position and (parallel) cross derivatives, so the faces OCCT reads meet G1: the
     normal lines' angle at 200 points along the seam, computed by OCCT, is ≤ 1e-5 rad."""
     path, fits = build(name, tmp_path)
-    fs = dict(zip(fits, faces(read(path))))
+    shape = read(path)
+    # the blend and its two surfaces share their seam edges: one connected shell
+    assert count(shape, TopAbs_SHELL) == 1 and BRepCheck_Analyzer(shape).IsValid()
+    fs = dict(zip(fits, faces(shape)))
     v0, v1 = BRep_Tool.Surface_s(fs[patch]).Bounds()[2:]
     vs = np.linspace(v0, v1, 200)
     na, nb = normals(fs[patch], u, vs), normals(fs[surface], su, vs)
