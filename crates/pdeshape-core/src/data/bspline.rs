@@ -139,62 +139,6 @@ impl BSplineCurve {
         idx.min(n - 1)
     }
 
-    /// Derivatives of the non-zero basis functions before the final factor p!/(p−k)!
-    /// (The NURBS Book, A2.3).
-    fn ders_basis(&self, span: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
-        let p = self.degree;
-        let u = &self.knots;
-        let mut ndu = vec![vec![0.0; p + 1]; p + 1];
-        let mut left = vec![0.0; p + 1];
-        let mut right = vec![0.0; p + 1];
-        ndu[0][0] = 1.0;
-        for j in 1..=p {
-            left[j] = x - u[span + 1 - j];
-            right[j] = u[span + j] - x;
-            let mut saved = 0.0;
-            for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = ndu[r][j - 1] / ndu[j][r];
-                ndu[r][j] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            ndu[j][j] = saved;
-        }
-        let nd = nd.min(p);
-        let mut ders = vec![vec![0.0; p + 1]; nd + 1];
-        for j in 0..=p {
-            ders[0][j] = ndu[j][p];
-        }
-        let mut a = vec![vec![0.0; p + 1]; 2];
-        for r in 0..=p {
-            let (mut s1, mut s2) = (0usize, 1usize);
-            a[0][0] = 1.0;
-            for k in 1..=nd {
-                let mut d = 0.0;
-                let rk = r as isize - k as isize;
-                let pk = p - k;
-                if r >= k {
-                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
-                    d = a[s2][0] * ndu[rk as usize][pk];
-                }
-                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
-                for j in j1..=j2 {
-                    let idx = (rk + j as isize) as usize;
-                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
-                    d += a[s2][j] * ndu[idx][pk];
-                }
-                if r <= pk {
-                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
-                    d += a[s2][k] * ndu[r][pk];
-                }
-                ders[k][r] = d;
-                std::mem::swap(&mut s1, &mut s2);
-            }
-        }
-        ders
-    }
-
     /// `C⁽ᵏ⁾(v)` for `k = 0 … nd` (exact; zero above the degree).
     pub fn derivatives(&self, v: f64, nd: usize) -> Vec<Vec3> {
         let (x, dxdv) = self.knot_param(v);
@@ -213,17 +157,7 @@ impl BSplineCurve {
     }
 
     fn ders_basis_scaled(&self, span: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
-        // The algorithm's final scaling: multiply row k by p!/(p−k)!.
-        let mut d = self.ders_basis(span, x, nd);
-        let p = self.degree;
-        let mut r = p as f64;
-        for (k, row) in d.iter_mut().enumerate().skip(1) {
-            for x in row.iter_mut() {
-                *x *= r;
-            }
-            r *= (p - k) as f64;
-        }
-        d
+        basis_derivatives(&self.knots, self.degree, span, x, nd)
     }
 }
 
@@ -251,6 +185,69 @@ impl Field for BSplineCurve {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot != 0
     }
+}
+
+/// The `p + 1` non-zero B-spline basis functions of degree `p` on `knots` at `x` in knot
+/// span `span`, and their derivatives up to order `min(nd, p)`: row `k`, entry `r` is
+/// `dᵏ N_{span−p+r}/dxᵏ` (The NURBS Book, A2.3, with its final factor `p!/(p−k)!`).
+pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
+    let u = knots;
+    let mut ndu = vec![vec![0.0; p + 1]; p + 1];
+    let mut left = vec![0.0; p + 1];
+    let mut right = vec![0.0; p + 1];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = x - u[span + 1 - j];
+        right[j] = u[span + j] - x;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    let nd = nd.min(p);
+    let mut ders = vec![vec![0.0; p + 1]; nd + 1];
+    for j in 0..=p {
+        ders[0][j] = ndu[j][p];
+    }
+    let mut a = vec![vec![0.0; p + 1]; 2];
+    for r in 0..=p {
+        let (mut s1, mut s2) = (0usize, 1usize);
+        a[0][0] = 1.0;
+        for k in 1..=nd {
+            let mut d = 0.0;
+            let rk = r as isize - k as isize;
+            let pk = p - k;
+            if r >= k {
+                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                d = a[s2][0] * ndu[rk as usize][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                d += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                d += a[s2][k] * ndu[r][pk];
+            }
+            ders[k][r] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    let mut f = p as f64;
+    for (k, row) in ders.iter_mut().enumerate().skip(1) {
+        for x in row.iter_mut() {
+            *x *= f;
+        }
+        f *= (p - k) as f64;
+    }
+    ders
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! Clamped B-spline knot vectors and their basis functions with derivatives (the NURBS
-//! Book's `FindSpan`, `BasisFuns` and `DersBasisFuns`, Piegl & Tiller §2.5).
+//! Book's `FindSpan`, and `DersBasisFuns` shared with `data`'s B-spline curves, Piegl &
+//! Tiller §2.5).
 
 /// A clamped knot vector of degree `p`: `p + 1` equal knots at each end.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,61 +91,8 @@ impl Knots {
     pub fn basis(&self, x: f64, nd: usize) -> (usize, Vec<Vec<f64>>) {
         let p = self.degree;
         let i = self.span(x);
-        let u = &self.knots;
-        // ndu: basis functions (upper triangle incl. diagonal) and knot differences (lower)
-        let mut ndu = vec![vec![0.0; p + 1]; p + 1];
-        ndu[0][0] = 1.0;
-        let (mut left, mut right) = (vec![0.0; p + 1], vec![0.0; p + 1]);
-        for j in 1..=p {
-            left[j] = x - u[i + 1 - j];
-            right[j] = u[i + j] - x;
-            let mut saved = 0.0;
-            for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = ndu[r][j - 1] / ndu[j][r];
-                ndu[r][j] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            ndu[j][j] = saved;
-        }
-        let mut ders = vec![vec![0.0; p + 1]; nd + 1];
-        for j in 0..=p {
-            ders[0][j] = ndu[j][p];
-        }
-        let mut a = vec![vec![0.0; p + 1]; 2];
-        for r in 0..=p {
-            let (mut s1, mut s2) = (0usize, 1usize);
-            a[0][0] = 1.0;
-            for k in 1..=nd.min(p) {
-                let mut d = 0.0;
-                let rk = r as isize - k as isize;
-                let pk = p - k;
-                if r >= k {
-                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
-                    d = a[s2][0] * ndu[rk as usize][pk];
-                }
-                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
-                for j in j1..=j2 {
-                    let idx = (rk + j as isize) as usize;
-                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
-                    d += a[s2][j] * ndu[idx][pk];
-                }
-                if r <= pk {
-                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
-                    d += a[s2][k] * ndu[r][pk];
-                }
-                ders[k][r] = d;
-                std::mem::swap(&mut s1, &mut s2);
-            }
-        }
-        let mut f = p as f64;
-        for (k, row) in ders.iter_mut().enumerate().skip(1) {
-            for x in row.iter_mut() {
-                *x *= f;
-            }
-            f *= (p - k) as f64;
-        }
+        let mut ders = crate::data::basis_derivatives(&self.knots, p, i, x, nd);
+        ders.resize(nd + 1, vec![0.0; p + 1]); // zero above the degree
         (i, ders)
     }
 }
