@@ -570,17 +570,15 @@ impl Axis {
     }
 }
 
-/// Splits span `i` of the breakpoints `b` (ends included) into `pieces[i]` equal spans;
-/// returns the interior.
-fn refine(b: &[f64], pieces: &[usize]) -> Vec<f64> {
+/// Halves the marked spans of the breakpoints `b` (ends included); returns the interior.
+fn refine(b: &[f64], split: &[bool]) -> Vec<f64> {
     let mut out = Vec::new();
     for i in 0..b.len() - 1 {
         if i > 0 {
             out.push(b[i]);
         }
-        let n = pieces[i].max(1);
-        for k in 1..n {
-            out.push(b[i] + (b[i + 1] - b[i]) * k as f64 / n as f64);
+        if split[i] {
+            out.push(0.5 * (b[i] + b[i + 1]));
         }
     }
     out
@@ -642,7 +640,7 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
             };
             return Ok((b, report));
         }
-        let mut split = [vec![1_usize; bk[0].len() - 1], vec![1_usize; ncv]];
+        let mut split = [vec![false; bk[0].len() - 1], vec![false; ncv]];
         for (k, c) in cells.iter().enumerate() {
             if c.0 <= tol {
                 continue;
@@ -665,28 +663,18 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
             let (a, bb) = if m.is_nan() { (true, true) } else { (wu >= 0.25 * m, wv >= 0.25 * m) };
             // halved (more pieces at once, from the h^(p+1) rate, measured slower: the
             // estimate overshoots while kinks are still being found)
-            if a {
-                split[0][ij[0]] = 2;
-            }
-            if bb {
-                split[1][ij[1]] = 2;
-            }
+            split[0][ij[0]] |= a;
+            split[1][ij[1]] |= bb;
         }
         let next: Vec<Vec<f64>> = (0..2)
             .map(|d| {
-                // breakpoints of the axis as it now stands (kinks included), split where marked
+                // breakpoints of the axis as it now stands (kinks included), halved where marked
                 let mut b = vec![axes[d].lo];
                 b.extend(&axes[d].interior);
                 b.push(axes[d].hi);
-                let marks: Vec<usize> = b
+                let marks: Vec<bool> = b
                     .windows(2)
-                    .map(|w| {
-                        (0..bk[d].len() - 1)
-                            .filter(|&i| bk[d][i] <= w[0] && w[1] <= bk[d][i + 1])
-                            .map(|i| split[d][i])
-                            .max()
-                            .unwrap_or(1)
-                    })
+                    .map(|w| (0..bk[d].len() - 1).any(|i| split[d][i] && bk[d][i] <= w[0] && w[1] <= bk[d][i + 1]))
                     .collect();
                 refine(&b, &marks)
             })
