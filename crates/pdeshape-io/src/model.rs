@@ -698,6 +698,7 @@ fn trim_diagnostics(t: &crate::scene::TrimSetup) -> Value {
         "inside_before": r.inside_before,
         "inside_after": r.inside_after,
         "repair_sweeps": r.sweeps,
+        "untangle_moves": r.untangle_moves,
         "min_angle_deg": r.min_angle,
         "max_angle_deg": r.max_angle,
         "area_ratio": r.area_ratio,

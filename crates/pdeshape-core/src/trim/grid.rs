@@ -54,6 +54,9 @@ pub struct TrimReport {
     pub inside_after: usize,
     /// Winslow sweeps used.
     pub sweeps: usize,
+    /// Vertex moves of the local untangling that followed when Winslow's fixed point was
+    /// still folded (0 when Winslow alone repaired the grid).
+    pub untangle_moves: usize,
     /// Smallest and largest corner angle of any cell, degrees.
     pub min_angle: f64,
     /// Largest corner angle.
@@ -164,6 +167,207 @@ fn winslow_sweep(p: &mut [Uv], rings: usize, cols: usize) -> f64 {
     moved
 }
 
+/// Winslow sweeps in blocks of ten while cells are folded or vertices inside trims, up to
+/// `limit` sweeps in all or until the fold count has not dropped for `stall` sweeps.
+/// Returns the folds and inside vertices left (`inside` is only recounted once no cell is
+/// folded).
+fn smooth(
+    map: &LaplaceMap,
+    p: &mut [Uv],
+    (rings, cols): (usize, usize),
+    (mut folds, mut inside): (usize, usize),
+    sweeps: &mut usize,
+    limit: usize,
+    stall: usize,
+) -> (usize, usize) {
+    let (mut fewest, mut stalled) = (folds, 0);
+    while (folds > 0 || inside > 0) && *sweeps < limit && stalled < stall {
+        for _ in 0..10 {
+            crate::cancel::checkpoint();
+            winslow_sweep(p, rings, cols);
+        }
+        *sweeps += 10;
+        folds = count_folds(p, rings, cols);
+        inside = if folds == 0 { count_inside(map, p, rings, cols) } else { inside.max(1) };
+        if folds > 0 && folds >= fewest {
+            stalled += 10;
+        } else {
+            (fewest, stalled) = (folds.min(fewest), 0);
+        }
+    }
+    (folds, inside)
+}
+
+/// Local untangling of the folded cells (after Freitag & Plassmann, "Local
+/// optimization-based untangling algorithms for quadrilateral meshes", 2001).
+///
+/// Every corner Jacobian of a cell is the doubled signed area of a triangle of its
+/// corners, `J = (b − a) × (c − a)`, so with all other vertices fixed it is an affine
+/// function of any one free vertex `x`: written with `x` first in the cyclic order,
+/// `J(x) = (b − x) × (c − x)` has gradient `(b_y − c_y, c_x − b_x)`. Moving `x` to maximise
+/// the smallest Jacobian of the cells around it is then a linear programme in `(x, t)`
+/// whose optimum is a vertex where three of the affine functions are equal; the functions
+/// are few (≤ 12 corners and 4 box walls), so the vertices are enumerated. The box walls —
+/// the distances to the bounding box of the eight neighbours, scaled to Jacobian units —
+/// keep the programme bounded. A corner at a ring-0 vertex where the region is reflex
+/// (the loop turns towards the hole) may stay non-positive, as [`is_folded`] allows; the
+/// cell's signed area (the sum of its corners) must stay positive instead.
+///
+/// Passes sweep the free vertices of the folded cells until none is folded or a pass
+/// moves nothing. Returns the number of moves.
+fn untangle(p: &mut [Uv], rings: usize, cols: usize) -> usize {
+    if rings < 3 {
+        return 0;
+    }
+    let at = |p: &[Uv], a: usize, b: usize| p[a * cols + (b + cols) % cols];
+    // the region turns reflex at ring-0 vertex j when the loop turns left there (the
+    // region lies to the right of a positively oriented grid's ring 0); vertices on a
+    // straight edge turn by round-off only, so the sine of the turn must exceed 1e-6
+    let reflex: Vec<Option<Uv>> = (0..cols)
+        .map(|j| {
+            let (a, b) = (sub(at(p, 0, j), at(p, 0, j + cols - 1)), sub(at(p, 0, j + 1), at(p, 0, j)));
+            let (la, lb) = (a[0].hypot(a[1]), b[0].hypot(b[1]));
+            // the outward bisector: away from both loop neighbours
+            let n = [a[0] / la - b[0] / lb, a[1] / la - b[1] / lb];
+            let ln = n[0].hypot(n[1]);
+            (cross(a, b) > 1e-6 * la * lb && ln > 0.0).then(|| [n[0] / ln, n[1] / ln])
+        })
+        .collect();
+    let mut moves = 0;
+    for _pass in 0..64 {
+        // first the free vertices at the folded cells' inverted corners, then the other free
+        // vertices of those corners' triangles (moving a valid vertex before the inverted
+        // one drags it towards where the inverted one is)
+        let mut first: Vec<(usize, usize)> = Vec::new();
+        let mut then: Vec<(usize, usize)> = Vec::new();
+        for i in 0..rings - 1 {
+            for j in 0..cols {
+                if !is_folded(p, cols, i, j) {
+                    continue;
+                }
+                let q = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(a, b)| (a, b % cols));
+                for (k, jac) in corner_jacobians(p, cols, i, j).into_iter().enumerate() {
+                    if jac > 0.0 || (q[k].0 == 0 && reflex[q[k].1].is_some()) {
+                        continue;
+                    }
+                    first.push(q[k]);
+                    then.extend([q[(k + 1) % 4], q[(k + 3) % 4]]);
+                }
+            }
+        }
+        let mut free: Vec<(usize, usize)> = Vec::new();
+        for v in first.into_iter().chain(then) {
+            if v.0 > 0 && v.0 < rings - 1 && !free.contains(&v) {
+                free.push(v);
+            }
+        }
+        if free.is_empty() {
+            break;
+        }
+        let mut moved = false;
+        for (i, j) in free {
+            if let Some(x) = best_position(p, cols, &reflex, i, j) {
+                p[i * cols + j] = x;
+                moved = true;
+                moves += 1;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    moves
+}
+
+/// The position of free vertex `(i, j)` that maximises the smallest constrained Jacobian
+/// of its four cells ([`untangle`]), or `None` when no position beats the current one.
+fn best_position(p: &[Uv], cols: usize, reflex: &[Option<Uv>], i: usize, j: usize) -> Option<Uv> {
+    let x0 = p[i * cols + j];
+    let at = |a: usize, b: usize| p[a * cols + (b + cols) % cols];
+    // affine functions f(d) = g·d + c of the displacement d = x − x0
+    let mut f: Vec<(Uv, f64)> = Vec::with_capacity(16);
+    for (ci, cj, m) in [(i - 1, j + cols - 1, 2), (i - 1, j, 1), (i, j + cols - 1, 3), (i, j, 0)] {
+        // corners P00, P10, P11, P01 of cell (ci, cj); x is corner m
+        let q = [(ci, cj), (ci + 1, cj), (ci + 1, cj + 1), (ci, cj + 1)];
+        let mut sum: (Uv, f64) = ([0.0, 0.0], 0.0);
+        let mut allowed = false;
+        for k in 0..4 {
+            let tri = [k, (k + 1) % 4, (k + 3) % 4];
+            let Some(r) = tri.iter().position(|&t| t == m) else {
+                let (a, b, c) = (at(q[k].0, q[k].1), at(q[tri[1]].0, q[tri[1]].1), at(q[tri[2]].0, q[tri[2]].1));
+                sum.1 += cross(sub(b, a), sub(c, a));
+                continue;
+            };
+            // x first in the cyclic order (x, b, c)
+            let (b, c) =
+                (at(q[tri[(r + 1) % 3]].0, q[tri[(r + 1) % 3]].1), at(q[tri[(r + 2) % 3]].0, q[tri[(r + 2) % 3]].1));
+            let g = [b[1] - c[1], c[0] - b[0]];
+            let v = cross(sub(b, x0), sub(c, x0));
+            sum = ([sum.0[0] + g[0], sum.0[1] + g[1]], sum.1 + v);
+            if q[k].0 == 0 && reflex[q[k].1 % cols].is_some() {
+                allowed = true;
+            } else {
+                f.push((g, v));
+            }
+        }
+        if allowed {
+            f.push(sum);
+        }
+    }
+    // box walls of the eight neighbours, in Jacobian units
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for a in i - 1..=i + 1 {
+        for b in [j + cols - 1, j, j + 1] {
+            if (a, b % cols) != (i, j) {
+                let q = at(a, b);
+                for d in 0..2 {
+                    lo[d] = lo[d].min(q[d] - x0[d]);
+                    hi[d] = hi[d].max(q[d] - x0[d]);
+                }
+            }
+        }
+    }
+    let scale = f.iter().map(|(g, _)| g[0].abs() + g[1].abs()).fold(0.0, f64::max);
+    if !(scale > 0.0 && scale.is_finite()) {
+        return None;
+    }
+    f.push(([scale, 0.0], -scale * lo[0]));
+    f.push(([-scale, 0.0], scale * hi[0]));
+    f.push(([0.0, scale], -scale * lo[1]));
+    f.push(([0.0, -scale], scale * hi[1]));
+    // beside a reflex loop vertex T the two corners at T share the region's angle (< 360°),
+    // so at most one of them is reflex — provided x stays on the outer side of the
+    // half-plane through T normal to the outward bisector n (else both corners can turn
+    // negative with the vertex inside the hole): (x − T)·n ≥ t, in Jacobian units
+    if i == 1
+        && let Some(n) = reflex[j]
+    {
+        let t = sub(x0, at(0, j));
+        f.push(([scale * n[0], scale * n[1]], scale * (t[0] * n[0] + t[1] * n[1])));
+    }
+    let worst = |d: Uv| f.iter().map(|(g, c)| g[0] * d[0] + g[1] * d[1] + c).fold(f64::INFINITY, f64::min);
+    let (mut best, mut best_d) = (worst([0.0, 0.0]), [0.0, 0.0]);
+    for a in 0..f.len() {
+        for b in a + 1..f.len() {
+            for c in b + 1..f.len() {
+                // f_a = f_b = f_c: two linear equations in d
+                let (r1, r2) = (sub(f[a].0, f[b].0), sub(f[a].0, f[c].0));
+                let det = cross(r1, r2);
+                if det == 0.0 {
+                    continue;
+                }
+                let (s1, s2) = (f[b].1 - f[a].1, f[c].1 - f[a].1);
+                let d = [(s1 * r2[1] - s2 * r1[1]) / det, (r1[0] * s2 - r2[0] * s1) / det];
+                let w = worst(d);
+                if w > best {
+                    (best, best_d) = (w, d);
+                }
+            }
+        }
+    }
+    (best > f64::NEG_INFINITY && best_d != [0.0, 0.0]).then(|| [x0[0] + best_d[0], x0[1] + best_d[1]])
+}
+
 /// Meshes the trimmed region: the Laplace map on the `(ρ, φ)` grid, then, if any cell is
 /// folded (or, with `verify`, any interior vertex lies in a hole), Winslow smoothing of
 /// the interior rings until none is. The boundary rings are never moved, so ring 0 stays
@@ -176,17 +380,23 @@ pub fn trim_grid(map: &LaplaceMap, o: &TrimOptions) -> Result<TrimGrid, TrimErro
     let mut p = map.grid(rings, cols);
     let folds_before = count_folds(&p, rings, cols);
     let inside_before = if o.verify || folds_before > 0 { count_inside(map, &p, rings, cols) } else { 0 };
-    let mut folds = folds_before;
-    let mut inside = inside_before;
     let mut sweeps = 0;
-    while (folds > 0 || inside > 0) && sweeps < o.max_sweeps {
-        for _ in 0..10 {
-            crate::cancel::checkpoint();
-            winslow_sweep(&mut p, rings, cols);
+    // Winslow's equations have a folded fixed point near sharp convex trim corners (a
+    // spike of the hole): stop sweeping once the fold count has not dropped for
+    // `STALL` sweeps and untangle locally; if that does not finish, sweep on.
+    const STALL: usize = 200;
+    let (mut folds, mut inside) =
+        smooth(map, &mut p, (rings, cols), (folds_before, inside_before), &mut sweeps, o.max_sweeps, STALL);
+    let mut untangle_moves = 0;
+    if folds > 0 {
+        let mut q = p.clone();
+        let moves = untangle(&mut q, rings, cols);
+        if count_folds(&q, rings, cols) == 0 && count_inside(map, &q, rings, cols) == 0 {
+            (p, folds, inside, untangle_moves) = (q, 0, 0, moves);
+        } else {
+            (folds, inside) =
+                smooth(map, &mut p, (rings, cols), (folds, inside), &mut sweeps, o.max_sweeps, usize::MAX);
         }
-        sweeps += 10;
-        folds = count_folds(&p, rings, cols);
-        inside = if folds == 0 { count_inside(map, &p, rings, cols) } else { inside.max(1) };
     }
     if folds > 0 || inside > 0 {
         // while folds remained, `inside` was not recounted: count it for the error
@@ -201,6 +411,7 @@ pub fn trim_grid(map: &LaplaceMap, o: &TrimOptions) -> Result<TrimGrid, TrimErro
     report.folds_before = folds_before;
     report.inside_before = inside_before;
     report.sweeps = sweeps;
+    report.untangle_moves = untangle_moves;
     Ok(TrimGrid { rings, columns: cols, points: p, report })
 }
 
@@ -293,4 +504,66 @@ pub fn trimmed_mesh(s: &dyn Surface, g: &TrimGrid) -> Result<Mesh, String> {
     let mut ring0: Vec<Vec3> = (0..g.columns).map(|j| positions[j]).collect();
     ring0.push(positions[0]);
     Ok(Mesh { positions, normals, uvs, quads, triangles, curves: vec![ring0], ..Default::default() })
+}
+
+#[cfg(test)]
+mod untangle_tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    /// A polar grid about the origin (ring radii 1, 2, …), positively oriented.
+    fn polar(rings: usize, cols: usize) -> Vec<Uv> {
+        (0..rings)
+            .flat_map(|i| {
+                (0..cols).map(move |j| {
+                    let (r, t) = (1.0 + i as f64, TAU * j as f64 / cols as f64);
+                    [r * t.cos(), r * t.sin()]
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_vertex_dragged_across_its_neighbours_is_put_back_inside() {
+        let (rings, cols) = (4, 12);
+        let mut p = polar(rings, cols);
+        assert_eq!(count_folds(&p, rings, cols), 0);
+        // (2, 3) moved beyond ring 3: its cells fold
+        let k = 2 * cols + 3;
+        let home = p[k];
+        p[k] = [home[0] * 1.8, home[1] * 1.8];
+        assert!(count_folds(&p, rings, cols) >= 2);
+        let moves = untangle(&mut p, rings, cols);
+        assert_eq!(count_folds(&p, rings, cols), 0);
+        assert!(moves >= 1);
+        // the max–min position lies between rings 1 and 3 (radii 2 and 4)
+        let r = p[k][0].hypot(p[k][1]);
+        assert!(r > 2.0 && r < 4.0, "radius {r}");
+        // vertices away from the fold stay put; its neighbours move less than a cell
+        let q = polar(rings, cols);
+        for m in 0..p.len() {
+            let (i, j) = (m / cols, m % cols);
+            let d = (p[m][0] - q[m][0]).hypot(p[m][1] - q[m][1]);
+            if m != k {
+                assert!(
+                    if i.abs_diff(2) <= 1 && j.abs_diff(3) <= 1 { d < 0.5 } else { d == 0.0 },
+                    "({i}, {j}) moved {d}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn at_a_reflex_loop_vertex_the_ring_one_vertex_stays_outside_the_hole() {
+        // ring 0: a square hole with one spike vertex at column 0 pointing along +x
+        let (rings, cols) = (3, 8);
+        let mut p = polar(rings, cols);
+        p[0] = [2.5, 0.0]; // spike tip, between rings 1 and 2 in radius
+        p[cols] = [1.0, 0.0]; // ring-1 vertex pulled back into the spike
+        assert!(count_folds(&p, rings, cols) > 0);
+        untangle(&mut p, rings, cols);
+        assert_eq!(count_folds(&p, rings, cols), 0);
+        // outward bisector at the tip is +x: the ring-1 vertex lies beyond the tip
+        assert!(p[cols][0] > 2.5, "{:?}", p[cols]);
+    }
 }

@@ -401,3 +401,29 @@ fn points_between_a_chord_and_its_arc_are_judged_by_the_curve() {
         assert!(!reg.in_hole(at(t, r + 2.0 * sag), 0.0) && reg.in_hole(at(t, r - 2.0 * sag), 0.0));
     }
 }
+
+/// A failing case of `random_nonconvex_trims` (a 34° spike of the hole polygon): Winslow's
+/// fixed point keeps one folded cell beside the spike, which the local untangling repairs.
+#[test]
+fn spike_beside_a_polygon_dent_is_untangled() {
+    let jitter = [
+        0.9854522988377276,
+        0.9093107148629781,
+        0.9960210252240491,
+        0.9761704196621998,
+        0.85,
+        0.9517210606510179,
+        0.85,
+        0.907273284889868,
+        0.9750502074969778,
+        0.85,
+        0.85,
+        0.85,
+    ];
+    let c = [0.528823337768761, 0.43599714116460886];
+    let r = region(vec![("n", dented(c, 0.2984255953552473, 0.4, 5, &jitter, true))]);
+    let map = LaplaceMap::new(r.clone(), 16, Some(96));
+    let g = trim_grid(&map, &opts(24, 96)).unwrap();
+    assert_valid(&r, &g);
+    assert!(g.report.untangle_moves > 0 && g.report.sweeps < 1000, "{:?}", g.report);
+}
