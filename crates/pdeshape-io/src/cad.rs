@@ -3,7 +3,7 @@
 //! seams between the fitted faces measured after the fit.
 
 use crate::export::{StepFace, write_atomic, write_step};
-use crate::scene::{Scene, ScenePatch};
+use crate::scene::Scene;
 use pdeshape_core::Vec3;
 use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_curve, fit_surface};
 use pdeshape_core::num::max_nan;
@@ -25,6 +25,8 @@ pub struct CadFace {
     pub primary: bool,
     /// Holes cut by trim curves: inner boundaries of the face.
     pub holes: Vec<Hole>,
+    /// A boundary face of a solid: whether its normal `S_u × S_v` points out of the solid.
+    pub outward: Option<bool>,
 }
 
 /// A trim curve as an inner boundary: its image on the fitted surface as a space curve.
@@ -53,15 +55,8 @@ pub struct Seam {
     pub samples: usize,
 }
 
-/// Why a patch cannot be exported (yet).
-fn exportable(p: &ScenePatch) -> Result<(), String> {
-    if p.solid.is_some() {
-        return Err(format!("patch `{}` is a solid blend: solids (closed shells) are not written to STEP yet", p.name));
-    }
-    Ok(())
-}
-
-/// Fits every patch of `sc` (dynamic blends at their first time), then the drawn part of
+/// Fits every patch of `sc` (dynamic blends at their first time; a solid blend as the
+/// faces that bound it, [`pdeshape_core::solid::boundary_faces`]), then the drawn part of
 /// every primary surface (`s_range`; at time 0), to `tolerance` (absolute; `None`: 1e-6 ×
 /// each face's bounding-box diagonal). Errors name the patch or surface.
 pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, String> {
@@ -82,12 +77,35 @@ pub fn fit_scene_relative(
             return Err(format!("tolerance {t} is not a positive number"));
         }
     }
-    // faces are named as the mesh exporters name them: `x` for a patch, `surface-x`
-    // (label for errors, face name, surface, C0 lines in v)
-    type Job = (String, String, Arc<dyn Surface>, Vec<f64>);
+    // faces are named as the mesh exporters name them: `x` for a patch, `surface-x`, and
+    // `x-u1`, `x-w0`, … for a solid's faces
+    struct Job {
+        label: String,
+        name: String,
+        surface: Arc<dyn Surface>,
+        v_breaks: Vec<f64>,
+        /// The patch whose surface this is (not a solid's face)
+        patch: Option<usize>,
+        /// A solid's face: (the patch, the solid's directions of the face's u and v,
+        /// whether S_u × S_v points out)
+        solid: Option<(usize, [usize; 2], bool)>,
+    }
     let mut jobs: Vec<Job> = Vec::new();
-    for p in &sc.patches {
-        exportable(p)?;
+    for (pi, p) in sc.patches.iter().enumerate() {
+        if let Some(sd) = &p.solid {
+            for f in pdeshape_core::solid::boundary_faces(&sd.blend) {
+                let outward = f.outward_at(0.5, 0.5);
+                jobs.push(Job {
+                    label: format!("patch `{}`, face {}", p.name, f.label()),
+                    name: format!("{}-{}", p.name, f.label()),
+                    solid: Some((pi, f.dirs, outward)),
+                    surface: Arc::new(f),
+                    v_breaks: Vec::new(),
+                    patch: None,
+                });
+            }
+            continue;
+        }
         let v_breaks = p.fill.as_ref().map(|f| f.corner_parameters()).unwrap_or_default();
         let surface: Arc<dyn Surface> = match (&p.dynamic, time) {
             (Some(d), Some(t)) => {
@@ -97,21 +115,72 @@ pub fn fit_scene_relative(
             }
             _ => p.surface.clone(),
         };
-        jobs.push((format!("patch `{}`", p.name), p.name.clone(), surface, v_breaks));
+        jobs.push(Job {
+            label: format!("patch `{}`", p.name),
+            name: p.name.clone(),
+            surface,
+            v_breaks,
+            patch: Some(pi),
+            solid: None,
+        });
     }
+    let n_patch_faces = jobs.len();
     for s in &sc.surfaces {
         let Some(range) = s.s_range else { continue };
         let ps = PrimarySurface::new(s.field.clone(), range, s.domain, time.unwrap_or(0.0));
-        jobs.push((format!("surface `{}`", s.name), format!("surface-{}", s.name), Arc::new(ps), Vec::new()));
+        jobs.push(Job {
+            label: format!("surface `{}`", s.name),
+            name: format!("surface-{}", s.name),
+            surface: Arc::new(ps),
+            v_breaks: Vec::new(),
+            patch: None,
+            solid: None,
+        });
     }
-    let n_patches = sc.patches.len();
-    let fit = |k: usize, v_start: Vec<f64>| -> Result<CadFace, String> {
-        let (label, name, s, v_breaks) = &jobs[k];
-        let o = FitOptions { tolerance, relative, v_breaks: v_breaks.clone(), v_start, ..Default::default() };
-        let (surface, report) = fit_surface(s.as_ref(), &o).map_err(|e| format!("{label}: {e}"))?;
-        Ok(CadFace { name: name.clone(), surface, report, primary: k >= n_patches, holes: Vec::new() })
+    let fit = |k: usize, u_start: Vec<f64>, v_start: Vec<f64>| -> Result<CadFace, String> {
+        let j = &jobs[k];
+        let o =
+            FitOptions { tolerance, relative, v_breaks: j.v_breaks.clone(), u_start, v_start, ..Default::default() };
+        let (surface, report) = fit_surface(j.surface.as_ref(), &o).map_err(|e| format!("{}: {e}", j.label))?;
+        Ok(CadFace {
+            name: j.name.clone(),
+            surface,
+            report,
+            primary: k >= n_patch_faces,
+            holes: Vec::new(),
+            outward: j.solid.map(|s| s.2),
+        })
     };
-    let mut out = (0..jobs.len()).map(|k| fit(k, Vec::new())).collect::<Result<Vec<_>, _>>()?;
+    let mut out = (0..jobs.len()).map(|k| fit(k, Vec::new(), Vec::new())).collect::<Result<Vec<_>, _>>()?;
+    // a solid's faces meet along edges in every direction: each direction of the solid
+    // gets the union of its faces' breakpoints, until they all agree (knots only grow)
+    let interior = |b: &[f64]| b[1..b.len() - 1].to_vec();
+    for pi in 0..sc.patches.len() {
+        let members: Vec<(usize, [usize; 2])> =
+            jobs.iter().enumerate().filter_map(|(k, j)| j.solid.filter(|s| s.0 == pi).map(|s| (k, s.1))).collect();
+        for _ in 0..8 {
+            let mut union: [Vec<f64>; 3] = Default::default();
+            for &(k, dirs) in &members {
+                for (d, b) in dirs.into_iter().zip([out[k].surface.u.breakpoints(), out[k].surface.v.breakpoints()]) {
+                    union[d].extend(b);
+                }
+            }
+            for u in &mut union {
+                u.sort_by(f64::total_cmp);
+                u.dedup();
+            }
+            let mut changed = false;
+            for &(k, [du, dv]) in &members {
+                if out[k].surface.u.breakpoints() != union[du] || out[k].surface.v.breakpoints() != union[dv] {
+                    out[k] = fit(k, interior(&union[du]), interior(&union[dv]))?;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
     // faces that meet along an edge are refitted from the union of their v breakpoints
     // until they share them (knots only grow, so this ends): their common edge is then
     // one curve and, with the cross derivatives interpolated at the ends, one tangent plane
@@ -124,6 +193,10 @@ pub fn fit_scene_relative(
         k
     }
     for s in seams(&out, 9) {
+        // a solid's faces have their knots already
+        if s.faces.iter().any(|f| jobs[f.0].solid.is_some()) {
+            continue;
+        }
         let (a, b) = (root(&mut group, s.faces[0].0), root(&mut group, s.faces[1].0));
         group[a] = b;
     }
@@ -141,7 +214,7 @@ pub fn fit_scene_relative(
             let mut changed = false;
             for &k in &members {
                 if breaks(&out[k]) != union {
-                    out[k] = fit(k, union[1..union.len() - 1].to_vec())?;
+                    out[k] = fit(k, Vec::new(), interior(&union))?;
                     let mut u: Vec<f64> = union.iter().copied().chain(breaks(&out[k])).collect();
                     u.sort_by(f64::total_cmp);
                     u.dedup();
@@ -155,9 +228,10 @@ pub fn fit_scene_relative(
         }
     }
     // trim curves: their images on the final surfaces
-    for (k, p) in sc.patches.iter().enumerate() {
+    for (pi, p) in sc.patches.iter().enumerate() {
         let Some(t) = &p.trim else { continue };
         let region = t.map.region();
+        let Some(k) = jobs.iter().position(|j| j.patch == Some(pi)) else { continue };
         let f = &mut out[k];
         for (i, (name, c)) in t.curves.iter().enumerate() {
             let corners = match c {
@@ -242,6 +316,7 @@ fn step_faces(faces: &[CadFace]) -> Vec<StepFace<'_>> {
             name: &p.name,
             surface: &p.surface,
             holes: p.holes.iter().map(|h| (&h.curve, h.counter_clockwise)).collect(),
+            outward: p.outward,
         })
         .collect()
 }

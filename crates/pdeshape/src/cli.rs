@@ -727,7 +727,9 @@ fn cad_seams(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<pdeshape_io::cad::Seam
         .into_iter()
         .filter(|s| {
             let [(a, ua), (b, ub)] = s.faces;
-            fitted[a].primary || fitted[b].primary || ua != ub
+            // a solid's faces meet at its edges, at an angle by construction: not seams
+            let solid = fitted[a].outward.is_some() && fitted[b].outward.is_some();
+            !solid && (fitted[a].primary || fitted[b].primary || ua != ub)
         })
         .collect()
 }

@@ -125,7 +125,8 @@ fn a_fill_is_one_certified_face_in_a_complete_ap214_file() {
 fn step_refusals_name_the_cause_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, extra, expect) in [
-        ("solid-cubes.toml", vec![], "solid blend"),
+        // the disc's √(1 − x²) has no derivative at its rim, where the face u = 0 starts
+        ("solid-cylinder-cube.toml", vec![], "face u0: the patch is not finite"),
         ("four-curve-patch.toml", vec!["--tolerance", "1e-15"], "was not reached"),
     ] {
         let out = dir.path().join("x.step");
@@ -192,4 +193,51 @@ fn a_blend_and_its_surfaces_are_one_shell() {
         defs.values().filter(|b| b.starts_with("ADVANCED_FACE(") && b.ends_with(",.F.)")).collect();
     assert_eq!(flipped.len(), 1, "{flipped:?}");
     assert!(flipped[0].starts_with("ADVANCED_FACE('surface-cylinder',"), "{}", flipped[0]);
+}
+
+/// A solid blend is a solid: the cylinders' three bounding faces (the lateral face `u = 1`,
+/// the end discs `w = 0, 1`; the axis `u = 0` and the seam faces `v = 0, 1` bound nothing)
+/// share their two rims, so every edge is used twice — by two faces, or by one face along
+/// its seam — and the shell is closed: a `MANIFOLD_SOLID_BREP` in an advanced B-rep
+/// representation. Within the shell each edge runs once each way (OCCT confirms that the
+/// orientation is outward, by the volume, in `crates/pdeshape-io/tests/occt`).
+#[test]
+fn a_solid_blend_is_a_closed_shell() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.step");
+    let o = build(&example("solid-cylinders.toml"), &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    for face in ["solid-u1", "solid-w0", "solid-w1"] {
+        assert!(err.contains(&format!("face {face}: B-spline")), "{err}");
+    }
+    let text = std::fs::read_to_string(&out).unwrap();
+    let (defs, refs) = entities(&text);
+    assert!(refs.iter().all(|r| defs.contains_key(r)));
+    assert_eq!(count(&defs, "CLOSED_SHELL"), 1);
+    assert_eq!(count(&defs, "MANIFOLD_SOLID_BREP"), 1);
+    assert_eq!(count(&defs, "OPEN_SHELL"), 0);
+    assert_eq!(count(&defs, "ADVANCED_BREP_SHAPE_REPRESENTATION"), 1);
+    assert_eq!(count(&defs, "ADVANCED_FACE"), 3);
+    // every edge twice, once each way after the faces' senses
+    let mut uses: HashMap<usize, Vec<bool>> = HashMap::new();
+    for face in defs.values().filter(|b| b.starts_with("ADVANCED_FACE(")) {
+        let same = face.ends_with(",.T.)");
+        for b in refs_in(face)
+            .iter()
+            .filter(|r| defs[r].starts_with("FACE_OUTER_BOUND(") || defs[r].starts_with("FACE_BOUND("))
+        {
+            let bound = &defs[b];
+            let lp = &defs[&refs_in(bound)[0]];
+            for oe in refs_in(lp) {
+                let body = &defs[&oe];
+                let edge = refs_in(body)[0];
+                uses.entry(edge).or_default().push(body.ends_with(",.T.)") == same);
+            }
+        }
+    }
+    assert_eq!(uses.len(), count(&defs, "EDGE_CURVE"));
+    for (e, u) in &uses {
+        assert!(u.len() == 2 && u[0] != u[1], "edge #{e}: {u:?}");
+    }
 }

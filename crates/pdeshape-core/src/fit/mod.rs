@@ -119,6 +119,9 @@ pub struct FitOptions {
     /// that meet along a `u` edge start from the union of each other's, so that they end
     /// with the same `v` knots and the same edge).
     pub v_start: Vec<f64>,
+    /// Interior `u` breakpoints to start from instead of `spans.0` uniform spans (the
+    /// faces of a solid, which meet along edges in either direction).
+    pub u_start: Vec<f64>,
 }
 
 impl Default for FitOptions {
@@ -131,6 +134,7 @@ impl Default for FitOptions {
             max_points: 400,
             v_breaks: Vec::new(),
             v_start: Vec::new(),
+            u_start: Vec::new(),
         }
     }
 }
@@ -609,9 +613,11 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
     };
     let p = o.degree;
     let mut axes = [Axis::new(0.0, 1.0, o.spans.0, &[]), Axis::new(dom.start, dom.end, o.spans.1, &o.v_breaks)];
-    if !o.v_start.is_empty() {
-        let ax = &mut axes[1];
-        let mut iv: Vec<f64> = o.v_start.iter().copied().filter(|&x| x > ax.lo && x < ax.hi).collect();
+    for (ax, start) in axes.iter_mut().zip([&o.u_start, &o.v_start]) {
+        if start.is_empty() {
+            continue;
+        }
+        let mut iv: Vec<f64> = start.iter().copied().filter(|&x| x > ax.lo && x < ax.hi).collect();
         iv.extend(&ax.c0);
         iv.sort_by(f64::total_cmp);
         iv.dedup();

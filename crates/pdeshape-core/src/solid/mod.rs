@@ -20,11 +20,13 @@
 
 mod blend;
 mod boundary;
+mod face;
 mod gauss;
 mod mass;
 
 pub use blend::{SolidBlend, SolidOperator, SolidOptions, SolidReport, Trial};
 pub use boundary::{boundary_mesh, boundary_mesh_of, cross_section, hex_mesh};
+pub use face::{SolidFace, boundary_faces};
 pub use gauss::gauss_legendre;
 pub use mass::MassProperties;
 

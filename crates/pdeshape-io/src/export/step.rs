@@ -3,11 +3,16 @@
 //!
 //! The file holds one product (`PRODUCT` → `PRODUCT_DEFINITION` → `PRODUCT_DEFINITION_SHAPE`
 //! → `SHAPE_DEFINITION_REPRESENTATION`; without the whole chain some readers import
-//! nothing) whose shape is a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION` holding a
-//! `SHELL_BASED_SURFACE_MODEL`: one `OPEN_SHELL` per set of faces joined by shared edges
+//! nothing) whose shape holds one shell per set of faces joined by shared edges
 //! (boundary curves with the same knots and control points within the uncertainty — faces
 //! fitted with common knots along a common edge — are one `EDGE_CURVE`; faces are flipped
-//! where needed so that the two faces of a shared edge run it in opposite directions). Each face is an `ADVANCED_FACE`
+//! where needed so that the two faces of a shared edge run it in opposite directions). A
+//! shell in which every edge joins two faces is a `CLOSED_SHELL` bounding a
+//! `MANIFOLD_SOLID_BREP`, oriented outward (the faces of a solid say which side is out);
+//! the others are `OPEN_SHELL`s of a `SHELL_BASED_SURFACE_MODEL`. The representation is an
+//! `ADVANCED_BREP_SHAPE_REPRESENTATION` (solids only), a
+//! `MANIFOLD_SURFACE_SHAPE_REPRESENTATION` (surfaces only) or a `SHAPE_REPRESENTATION`
+//! holding both. Each face is an `ADVANCED_FACE`
 //! over a `B_SPLINE_SURFACE_WITH_KNOTS`, bounded by the four boundary isocurves of its
 //! clamped net (exactly its first and last control rows and columns, with the surface's
 //! knots, as `B_SPLINE_CURVE_WITH_KNOTS`):
@@ -40,6 +45,9 @@ pub struct StepFace<'a> {
     /// Inner boundaries (holes): closed space curves on the surface, each with whether it
     /// runs counter-clockwise in the surface's `(u, v)`.
     pub holes: Vec<(&'a BSplineCurve3, bool)>,
+    /// A face of a solid: whether `S_u × S_v` points out of it (its closed shell is then
+    /// oriented outward).
+    pub outward: Option<bool>,
 }
 
 /// STEP's REAL: shortest round-trip digits with a decimal point and an upper-case exponent.
@@ -174,8 +182,9 @@ struct Topology {
     edges: Vec<(usize, usize)>,
     /// Faces to write with `same_sense` false.
     flip: Vec<bool>,
-    /// Connected components (one open shell each).
-    shells: Vec<Vec<usize>>,
+    /// Connected components (one shell each), and whether each is closed (every edge
+    /// joins two faces, or one face to itself along its seam).
+    shells: Vec<(Vec<usize>, bool)>,
 }
 
 fn topology(faces: &[StepFace], tol: f64) -> Topology {
@@ -237,7 +246,17 @@ fn topology(faces: &[StepFace], tol: f64) -> Topology {
             }
         }
         comp.sort_unstable();
-        shells.push(comp);
+        // a solid's shell faces outward: flip the whole component if its first face with
+        // a known outward side would be written inward
+        if let Some((f, o)) = comp.iter().find_map(|&f| faces[f].outward.map(|o| (f, o)))
+            && flip[f] == o
+        {
+            for &g in &comp {
+                flip[g] = !flip[g];
+            }
+        }
+        let closed = comp.iter().all(|&f| edge_of[f].iter().all(|&(_, e)| uses[e].len() == 2));
+        shells.push((comp, closed));
     }
     Topology { edge_of, edges, flip, shells }
 }
@@ -302,8 +321,8 @@ fn write_faces(e: &mut Entities, faces: &[StepFace], t: &Topology, tol: f64) -> 
     out
 }
 
-/// Writes `faces` as one product named `product` (a surface model of open shells, one per
-/// face). `uncertainty` is the distance below which points are one (the fit tolerance).
+/// Writes `faces` as one product named `product` (solids of the closed shells, a surface
+/// model of the open ones). `uncertainty` is the distance below which points are one (the fit tolerance).
 /// Refuses non-finite control points.
 pub fn write_step(w: &mut dyn Write, product: &str, faces: &[StepFace], uncertainty: f64) -> io::Result<()> {
     if let Some(f) = faces.iter().find(|f| f.surface.control.iter().any(|p| !p.is_finite())) {
@@ -342,17 +361,30 @@ pub fn write_step(w: &mut dyn Write, product: &str, faces: &[StepFace], uncertai
     let axes = e.add(&format!("AXIS2_PLACEMENT_3D('',#{o},#{z},#{x})"));
     let topo = topology(faces, uncertainty);
     let ids = write_faces(&mut e, faces, &topo, uncertainty);
-    let mut shells = Vec::with_capacity(topo.shells.len());
-    for comp in &topo.shells {
+    let (mut open, mut solids) = (Vec::new(), Vec::new());
+    for (comp, closed) in &topo.shells {
         let names: Vec<&str> = comp.iter().map(|&k| faces[k].name).collect();
-        shells.push(e.add(&format!(
-            "OPEN_SHELL({},{})",
-            string(&names.join("+")),
-            Entities::list(comp.iter().map(|&k| ids[k]))
-        )));
+        let list = Entities::list(comp.iter().map(|&k| ids[k]));
+        if *closed {
+            let shell = e.add(&format!("CLOSED_SHELL({},{list})", string(&names.join("+"))));
+            solids.push(e.add(&format!("MANIFOLD_SOLID_BREP({},#{shell})", string(&names.join("+")))));
+        } else {
+            open.push(e.add(&format!("OPEN_SHELL({},{list})", string(&names.join("+")))));
+        }
     }
-    let model = e.add(&format!("SHELL_BASED_SURFACE_MODEL('',{})", Entities::list(shells)));
-    let rep = e.add(&format!("MANIFOLD_SURFACE_SHAPE_REPRESENTATION({name},(#{axes},#{model}),#{ctx})"));
+    // solids alone: an advanced B-rep; surfaces alone: a surface model; both: the generic
+    // shape representation holding both kinds of item
+    let mut items = vec![axes];
+    items.extend(&solids);
+    if !open.is_empty() {
+        items.push(e.add(&format!("SHELL_BASED_SURFACE_MODEL('',{})", Entities::list(open.iter().copied()))));
+    }
+    let kind = match (solids.is_empty(), open.is_empty()) {
+        (false, true) => "ADVANCED_BREP_SHAPE_REPRESENTATION",
+        (true, _) => "MANIFOLD_SURFACE_SHAPE_REPRESENTATION",
+        (false, false) => "SHAPE_REPRESENTATION",
+    };
+    let rep = e.add(&format!("{kind}({name},{},#{ctx})", Entities::list(items)));
     e.add(&format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
 
     writeln!(w, "ISO-10303-21;")?;

@@ -1094,7 +1094,7 @@ fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<Sc
         return Err(ctx.err(None, format!("{key}.primary"), format!("{primary} is not a non-negative number")));
     }
     let blend = Arc::new(SolidBlend::new(op, faces.clone(), opts).map_err(|e| ctx.err(span(p), key, e.to_string()))?);
-    let surface = Arc::new(super::SolidSection { blend: blend.clone(), axis: 2, value: 0.5 });
+    let surface = Arc::new(pdeshape_core::solid::SolidFace::section(blend.clone(), 2, 0.5));
     Ok(ScenePatch {
         name: pname.to_string(),
         kind: PatchKind::Solid,

@@ -195,45 +195,6 @@ pub struct SolidSetup {
     pub primary: f64,
 }
 
-/// A cross section `axis = value` of a solid blend as a patch (the two other parameters in
-/// cyclic order).
-#[derive(Clone, Debug)]
-pub struct SolidSection {
-    /// The solid.
-    pub blend: Arc<pdeshape_core::solid::SolidBlend>,
-    /// 0: u, 1: v, 2: w.
-    pub axis: usize,
-    /// The fixed parameter value.
-    pub value: f64,
-}
-
-impl pdeshape_core::patch::Surface for SolidSection {
-    fn v_domain(&self) -> pdeshape_core::patch::VDomain {
-        pdeshape_core::patch::VDomain::open(0.0, 1.0)
-    }
-    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<pdeshape_core::Vec3> {
-        let (p, q) = ((self.axis + 1) % 3, (self.axis + 2) % 3);
-        let mut t = [0.0; 3];
-        let mut o = [0usize; 3];
-        t[self.axis] = self.value;
-        t[p] = u;
-        t[q] = v;
-        o[p] = du;
-        o[q] = dv;
-        let d = self.blend.derivatives(t[0], t[1], t[2], o[0], o[1], o[2]);
-        let mut out = Vec::with_capacity((du + 1) * (dv + 1));
-        for i in 0..=du {
-            for j in 0..=dv {
-                let mut m = [0usize; 3];
-                m[p] = i;
-                m[q] = j;
-                out.push(d[(m[0] * (o[1] + 1) + m[1]) * (o[2] + 1) + m[2]]);
-            }
-        }
-        out
-    }
-}
-
 /// A dynamic blend with its animation settings.
 #[derive(Clone, Debug)]
 pub struct DynamicSetup {
