@@ -33,12 +33,15 @@ pub struct CadFace {
 pub struct Hole {
     /// The trim curve's name.
     pub name: String,
-    /// `S(C(t))`, `t ∈ [0, 2π]`, fitted to the face's tolerance.
+    /// `S(C(t))`, `t ∈ [0, 2π]`, fitted to the face's tolerance — or the boundary
+    /// isocurve of the face standing on the hole ([`Hole::root_of`]).
     pub curve: pdeshape_core::fit::BSplineCurve3,
-    /// Its certified deviation from `S(C(t))`.
+    /// Its certified deviation from the exact `S(C(t))`.
     pub deviation: f64,
     /// The curve runs counter-clockwise in `(u, v)` (the face's inner loop runs it back).
     pub counter_clockwise: bool,
+    /// The face (index) standing on the hole, whose boundary isocurve is the curve.
+    pub root_of: Option<usize>,
 }
 
 /// Two fitted faces that meet along a boundary isocurve each (`u = 0` or `1` of both,
@@ -246,10 +249,51 @@ pub fn fit_scene_relative(
             let (curve, deviation) = fit_curve(&image, 0.0, std::f64::consts::TAU, &corners, f.report.tolerance, 4000)
                 .map_err(|e| format!("patch `{}`, trim curve `{name}`: {e}", p.name))?;
             let counter_clockwise = region.orientation.get(i).is_none_or(|&o| o > 0.0);
-            f.holes.push(Hole { name: name.clone(), curve, deviation, counter_clockwise });
+            f.holes.push(Hole { name: name.clone(), curve, deviation, counter_clockwise, root_of: None });
         }
     }
+    share_roots(&mut out);
     Ok(out)
+}
+
+/// A patch that stands on a hole (its `u = 0` or `1` condition is the trim curve carried
+/// onto the trimmed patch: the dolphin's fins) ends in the hole's curve. Where a face's
+/// boundary isocurve runs along a hole's curve at the same parameter (`v = t`, within the
+/// two tolerances at 17 probes), the hole takes that isocurve — control points and knots —
+/// as its curve, so that the STEP writer writes one edge for both and they are one shell.
+/// The isocurve lies within the standing face's certified deviation of the exact curve, and
+/// so within the sum of both tolerances of the trimmed face.
+fn share_roots(out: &mut [CadFace]) {
+    for b in 0..out.len() {
+        for h in 0..out[b].holes.len() {
+            let hole = &out[b].holes[h].curve;
+            let (t0, t1) = (hole.knots.breakpoints()[0], *hole.knots.breakpoints().last().expect("knots"));
+            let found = (0..out.len()).filter(|&f| f != b && out[f].surface.periodic_v).find_map(|f| {
+                let s = &out[f].surface;
+                let vb = s.v.breakpoints();
+                if (vb[0], vb[vb.len() - 1]) != (t0, t1) {
+                    return None;
+                }
+                // the hole curve lies within the trimmed face's tolerance of its fitted surface,
+                // which lies within it of the exact one
+                let tol = out[f].report.tolerance + 2.0 * out[b].report.tolerance;
+                [0.0, 1.0].into_iter().find_map(|u| {
+                    let on = (0..17).all(|k| {
+                        let t = t0 + (t1 - t0) * (k as f64 + 0.5) / 17.0;
+                        (s.point(u, t) - hole.point(t)).norm() <= tol
+                    });
+                    on.then_some((f, u))
+                })
+            });
+            if let Some((f, u)) = found {
+                let s = &out[f].surface;
+                let curve = pdeshape_core::fit::BSplineCurve3 { knots: s.v.clone(), control: s.u_edge(u == 1.0) };
+                let deviation = out[f].report.max_deviation;
+                let hole = &mut out[b].holes[h];
+                (hole.curve, hole.deviation, hole.root_of) = (curve, deviation, Some(f));
+            }
+        }
+    }
 }
 
 /// The unit normal `S_u × S_v` of a fitted face, or NaN where it degenerates.

@@ -219,25 +219,65 @@ fn a_solid_blend_is_a_closed_shell() {
     assert_eq!(count(&defs, "OPEN_SHELL"), 0);
     assert_eq!(count(&defs, "ADVANCED_BREP_SHAPE_REPRESENTATION"), 1);
     assert_eq!(count(&defs, "ADVANCED_FACE"), 3);
-    // every edge twice, once each way after the faces' senses
+    // every edge twice, once each way about the faces' normals
     let mut uses: HashMap<usize, Vec<bool>> = HashMap::new();
     for face in defs.values().filter(|b| b.starts_with("ADVANCED_FACE(")) {
-        let same = face.ends_with(",.T.)");
         for b in refs_in(face)
             .iter()
             .filter(|r| defs[r].starts_with("FACE_OUTER_BOUND(") || defs[r].starts_with("FACE_BOUND("))
         {
             let bound = &defs[b];
+            // the bound's orientation says how its loop runs about the face's normal
+            let with = bound.ends_with(",.T.)");
             let lp = &defs[&refs_in(bound)[0]];
             for oe in refs_in(lp) {
                 let body = &defs[&oe];
                 let edge = refs_in(body)[0];
-                uses.entry(edge).or_default().push(body.ends_with(",.T.)") == same);
+                uses.entry(edge).or_default().push(body.ends_with(",.T.)") == with);
             }
         }
     }
     assert_eq!(uses.len(), count(&defs, "EDGE_CURVE"));
     for (e, u) in &uses {
         assert!(u.len() == 2 && u[0] != u[1], "edge #{e}: {u:?}");
+    }
+}
+
+/// The dolphin is one shell: each fin's root edge (its isocurve `u = 0`) is the edge of
+/// one of the body's three holes, used once by the body's inner loop and once by the
+/// fin's outer loop, in opposite directions.
+#[test]
+fn the_dolphins_fins_share_their_roots_with_the_body() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d.step");
+    let o = build(&example("dolphin.toml"), &out, &["-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let (defs, _) = entities(&text);
+    assert_eq!(count(&defs, "OPEN_SHELL"), 1);
+    let face = |name: &str| defs.values().find(|b| b.starts_with(&format!("ADVANCED_FACE('{name}',"))).unwrap();
+    // (edge, direction about the face's normal: the bound's orientation already says how
+    // the loop runs about it, `same_sense` included) of a face's loops
+    let loops = |f: &String, outer: bool| -> Vec<(usize, bool)> {
+        let kind = if outer { "FACE_OUTER_BOUND(" } else { "FACE_BOUND(" };
+        let mut out = Vec::new();
+        for b in refs_in(f).into_iter().filter(|r| defs[r].starts_with(kind)) {
+            let bound = &defs[&b];
+            let with = bound.ends_with(",.T.)");
+            for oe in refs_in(&defs[&refs_in(bound)[0]]) {
+                let body = &defs[&oe];
+                out.push((refs_in(body)[0], body.ends_with(",.T.)") == with));
+            }
+        }
+        out
+    };
+    let holes = loops(face("body"), false);
+    assert_eq!(holes.len(), 3);
+    for fin in ["dorsal", "right_fin", "left_fin"] {
+        let shared: Vec<(usize, bool)> =
+            loops(face(fin), true).into_iter().filter(|(e, _)| holes.iter().any(|h| h.0 == *e)).collect();
+        assert_eq!(shared.len(), 1, "{fin}");
+        let hole = holes.iter().find(|h| h.0 == shared[0].0).unwrap();
+        assert_ne!(hole.1, shared[0].1, "{fin}: the root edge runs the same way in both faces");
     }
 }

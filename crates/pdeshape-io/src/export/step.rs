@@ -26,7 +26,8 @@
 //! - corners closer than the uncertainty share their vertex;
 //! - holes (trim curves) are inner `FACE_BOUND`s of one closed edge each, run clockwise
 //!   in `(u, v)`; their 3D curves lie on the written surface (readers compute the
-//!   pcurves by projection).
+//!   pcurves by projection) — or are the boundary of a face standing on the hole, whose
+//!   edge they then share (the dolphin's fins on its body).
 //!
 //! Lengths are written in millimetres (a scene's unit becomes 1 mm); the uncertainty —
 //! the distance below which two points are one — is the caller's (the fit tolerance).
@@ -187,8 +188,18 @@ struct Topology {
     shells: Vec<(Vec<usize>, bool)>,
 }
 
+/// The sides of a face's outer loop ([`sides`]) and its holes as sides `4, 5, …` (a hole
+/// runs clockwise in the face's loop; a face standing on the hole shares its edge).
+fn all_sides<'a>(f: &'a StepFace, tol: f64) -> Vec<(usize, Side<'a>)> {
+    let mut out = sides(f.surface, tol);
+    for (i, (c, ccw)) in f.holes.iter().enumerate() {
+        out.push((4 + i, Side { pts: c.control.clone(), knots: &c.knots, from: 0, to: 0, forward: !ccw }));
+    }
+    out
+}
+
 fn topology(faces: &[StepFace], tol: f64) -> Topology {
-    let sides: Vec<Vec<(usize, Side)>> = faces.iter().map(|f| sides(f.surface, tol)).collect();
+    let sides: Vec<Vec<(usize, Side)>> = faces.iter().map(|f| all_sides(f, tol)).collect();
     let mut edges: Vec<(usize, usize)> = Vec::new();
     let mut edge_of: Vec<Vec<(usize, usize)>> = Vec::with_capacity(faces.len());
     // uses[e]: (face, runs forward)
@@ -301,11 +312,20 @@ fn write_faces(e: &mut Entities, faces: &[StepFace], t: &Topology, tol: f64) -> 
         let sense = |b: bool| if b != t.flip[fi] { ".T." } else { ".F." };
         let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
         let mut bounds = vec![e.add(&format!("FACE_OUTER_BOUND('',#{lp},{})", sense(true)))];
-        for (c, ccw) in &f.holes {
-            // one closed edge from and to the curve's start; an inner loop runs clockwise
-            let start = vertex(e, c.control[0]);
-            let curve = e.curve(&c.control, &c.knots, tol);
-            let edge = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
+        for (i, (c, ccw)) in f.holes.iter().enumerate() {
+            // one closed edge from and to the curve's start (shared with a face standing on
+            // the hole); an inner loop runs clockwise
+            let ei = t.edge_of[fi].iter().find(|(kk, _)| *kk == 4 + i).expect("every hole has an edge").1;
+            let edge = match edge_ids[ei] {
+                Some(id) => id,
+                None => {
+                    let start = vertex(e, c.control[0]);
+                    let curve = e.curve(&c.control, &c.knots, tol);
+                    let id = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
+                    edge_ids[ei] = Some(id);
+                    id
+                }
+            };
             let flag = if *ccw { ".F." } else { ".T." };
             let oe = e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})"));
             let lp = e.add(&format!("EDGE_LOOP('',(#{oe}))"));

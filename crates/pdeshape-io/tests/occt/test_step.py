@@ -36,8 +36,10 @@ ROOT = Path(__file__).resolve().parents[4]
 
 # example: faces (patches and the drawn parts of primary surfaces); representative kinds:
 # a 4th-order PDE patch through creased polylines (kinks found by the fit), a blend, the
-# 40th-order Klein bottle (closed in v), N-sided fills (C0 corners, a pole)
+# 40th-order Klein bottle (closed in v), N-sided fills (C0 corners, a pole), the dolphin
+# (a trimmed body with fins standing on its holes)
 CASES = {
+    "dolphin": 5,
     "four-curve-patch": 1,
     "bloor-wilson-blend": 3,
     "klein-bottle": 1,
@@ -308,3 +310,28 @@ def test_a_solid_blend_is_a_closed_valid_solid_with_its_volume(name, tmp_path):
     tol = max(f[3] for f in fits.values())
     assert props.Mass() > 0
     assert abs(props.Mass() - volume) <= tol * area.Mass() + 1e-9 * volume, (props.Mass(), volume)
+
+
+def test_the_dolphin_is_one_shell_with_the_fins_on_the_body(tmp_path):
+    """Each fin's root is its boundary isocurve u = 0, and the body's hole there is that
+    same edge: OCCT reads one valid shell in which each of the three root edges bounds two
+    faces (the body and a fin), and the body's face has its outer wire and three holes."""
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_WIRE
+
+    def edges(face):
+        out, ex = [], TopExp_Explorer(face, TopAbs_EDGE)
+        while ex.More():
+            out.append(ex.Current())
+            ex.Next()
+        return out
+
+    path, fits = build("dolphin", tmp_path)
+    shape = read(path)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    assert count(shape, TopAbs_SHELL) == 1
+    fs = dict(zip(fits, faces(shape)))
+    assert count(fs["body"], TopAbs_WIRE) == 4
+    body = edges(fs["body"])
+    for fin in ["dorsal", "right_fin", "left_fin"]:
+        shared = {i for i, e in enumerate(body) for g in edges(fs[fin]) if e.IsSame(g)}
+        assert len(shared) == 1, (fin, shared)
