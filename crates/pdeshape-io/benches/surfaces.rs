@@ -191,7 +191,7 @@ fn cad_fit(c: &mut Criterion) {
     for name in ["dolphin", "bloor-wilson-blend", "fill-sphere-pentagon"] {
         let sc = load(&format!("{name}.toml"));
         g.bench_function(format!("{name}: every face at 1e-6 (certified)"), |b| {
-            b.iter(|| pdeshape_io::cad::fit_scene(&sc, None).unwrap())
+            b.iter(|| pdeshape_io::cad::fit_scene(&sc, &Default::default()).unwrap())
         });
     }
     g.finish();

@@ -54,27 +54,43 @@ pub struct Seam {
     pub gap: f64,
     /// Largest angle (radians) between the two faces' normal lines there.
     pub angle: f64,
+    /// Largest difference between the two faces' normal curvatures across the seam (in
+    /// the direction of the tangent plane normal to the edge), in 1/length.
+    pub curvature_gap: f64,
     /// Points compared.
     pub samples: usize,
 }
 
-/// Fits every patch of `sc` (dynamic blends at their first time; a solid blend as the
-/// faces that bound it, [`pdeshape_core::solid::boundary_faces`]), then the drawn part of
-/// every primary surface (`s_range`; at time 0), to `tolerance` (absolute; `None`: 1e-6 ×
-/// each face's bounding-box diagonal). Errors name the patch or surface.
-pub fn fit_scene(sc: &Scene, tolerance: Option<f64>) -> Result<Vec<CadFace>, String> {
-    fit_scene_relative(sc, tolerance, 1e-6, None)
+/// How a scene becomes CAD faces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CadOptions {
+    /// The certified maximum deviation of every face (absolute); `None`: `relative` ×
+    /// each face's bounding-box diagonal.
+    pub tolerance: Option<f64>,
+    /// The tolerance relative to each face's bounding-box diagonal (default 1e-6).
+    pub relative: f64,
+    /// B-spline degree: 3 (faces meeting along an edge stay G1), or 5 (the second cross
+    /// derivative is interpolated at the edges too, so curvature continuity survives).
+    pub degree: usize,
+    /// Dynamic blends (and the primary surfaces) at this time (clamped to each blend's
+    /// range); `None`: the first time (primary surfaces at 0).
+    pub time: Option<f64>,
 }
 
-/// [`fit_scene`] with the relative tolerance (× each face's bounding-box diagonal) used
-/// where `tolerance` is `None`, and dynamic blends (with the primary surfaces) at `time`
-/// (clamped to each blend's range; `None`: the first time).
-pub fn fit_scene_relative(
-    sc: &Scene,
-    tolerance: Option<f64>,
-    relative: f64,
-    time: Option<f64>,
-) -> Result<Vec<CadFace>, String> {
+impl Default for CadOptions {
+    fn default() -> Self {
+        CadOptions { tolerance: None, relative: 1e-6, degree: 3, time: None }
+    }
+}
+
+/// Fits every patch of `sc` (a solid blend as the faces that bound it,
+/// [`pdeshape_core::solid::boundary_faces`]), then the drawn part of every primary surface
+/// (`s_range`), to the tolerance of `o` ([`CadOptions`]). Errors name the patch or surface.
+pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
+    let (tolerance, relative, time) = (o.tolerance, o.relative, o.time);
+    if o.degree != 3 && o.degree != 5 {
+        return Err(format!("degree {}: the faces are of degree 3 or 5", o.degree));
+    }
     for t in tolerance.into_iter().chain([relative]) {
         if !(t.is_finite() && t > 0.0) {
             return Err(format!("tolerance {t} is not a positive number"));
@@ -142,9 +158,16 @@ pub fn fit_scene_relative(
     }
     let fit = |k: usize, u_start: Vec<f64>, v_start: Vec<f64>| -> Result<CadFace, String> {
         let j = &jobs[k];
-        let o =
-            FitOptions { tolerance, relative, v_breaks: j.v_breaks.clone(), u_start, v_start, ..Default::default() };
-        let (surface, report) = fit_surface(j.surface.as_ref(), &o).map_err(|e| format!("{}: {e}", j.label))?;
+        let fo = FitOptions {
+            tolerance,
+            relative,
+            degree: o.degree,
+            v_breaks: j.v_breaks.clone(),
+            u_start,
+            v_start,
+            ..Default::default()
+        };
+        let (surface, report) = fit_surface(j.surface.as_ref(), &fo).map_err(|e| format!("{}: {e}", j.label))?;
         Ok(CadFace {
             name: j.name.clone(),
             surface,
@@ -304,6 +327,23 @@ fn normal(b: &BSplineSurface, u: f64, v: f64) -> (Vec3, Vec3) {
     (d[0], if len > 0.0 { n * (1.0 / len) } else { Vec3::new(f64::NAN, f64::NAN, f64::NAN) })
 }
 
+/// The normal curvature of a fitted face at `(u, v)` in the tangent direction normal to
+/// the isocurve `u = const` (`t ∝ n × S_v`), with the normal `n` given (so that two faces'
+/// curvatures have the same sign convention): `κ = II(t, t)` for the unit `t = a S_u + b S_v`.
+fn cross_curvature(b: &BSplineSurface, u: f64, v: f64, n: Vec3) -> f64 {
+    // index i (dv + 1) + j of ∂^{i+j}/∂u^i∂v^j
+    let d = b.derivatives(u, v, 2, 2);
+    let (su, sv, suu, suv, svv) = (d[3], d[1], d[6], d[4], d[2]);
+    let t = n.cross(sv);
+    let t = t * (1.0 / t.norm());
+    // t = a S_u + b S_v: the 2 × 2 Gram system
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let (p, q) = (t.dot(su), t.dot(sv));
+    let det = e * g - f * f;
+    let (a, c) = ((p * g - q * f) / det, (e * q - f * p) / det);
+    a * a * suu.dot(n) + 2.0 * a * c * suv.dot(n) + c * c * svv.dot(n)
+}
+
 /// The seams between fitted faces: boundary isocurves `u = 0 | 1` of two faces that lie
 /// within `10 ×` the larger tolerance of each other at 9 probe values of `v` (same `v`
 /// domain). Each is then measured at `n` values of `v` (pole points, where a normal is
@@ -328,7 +368,7 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
                     if !probe {
                         continue;
                     }
-                    let (mut gap, mut angle) = (0.0_f64, 0.0_f64);
+                    let (mut gap, mut angle, mut curvature_gap) = (0.0_f64, 0.0_f64, 0.0_f64);
                     for k in 0..n {
                         let v = v0 + (v1 - v0) * k as f64 / (n - 1).max(1) as f64;
                         let ((pa, na), (pb, nb)) = (normal(fa, ua, v), normal(fb, ub, v));
@@ -336,9 +376,11 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
                         if na.is_finite() && nb.is_finite() {
                             // normal lines: the faces may be oriented either way
                             angle = max_nan(angle, na.cross(nb).norm().min(1.0).asin());
+                            let (ka, kb) = (cross_curvature(fa, ua, v, na), cross_curvature(fb, ub, v, na));
+                            curvature_gap = max_nan(curvature_gap, (ka - kb).abs());
                         }
                     }
-                    out.push(Seam { faces: [(a, ua), (b, ub)], gap, angle, samples: n });
+                    out.push(Seam { faces: [(a, ua), (b, ub)], gap, angle, curvature_gap, samples: n });
                 }
             }
         }

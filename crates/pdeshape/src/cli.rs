@@ -46,6 +46,10 @@ enum Command {
         /// (default 1e-6).
         #[arg(long, value_parser = positive)]
         relative_tolerance: Option<f64>,
+        /// STEP only: B-spline degree of the faces, 3 (default; seams stay G1) or 5 (the
+        /// curvature across seams survives too).
+        #[arg(long, value_parser = spline_degree)]
+        degree: Option<usize>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -64,6 +68,9 @@ enum Command {
         /// deviation and control points, and each seam's gap and angle after the fit.
         #[arg(long)]
         cad: bool,
+        /// With --cad: B-spline degree of the faces, 3 (default) or 5.
+        #[arg(long, value_parser = spline_degree, requires = "cad")]
+        degree: Option<usize>,
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
@@ -177,6 +184,15 @@ enum Command {
 fn finite(s: &str) -> Result<f64, String> {
     let x: f64 = s.trim().parse().map_err(|_| format!("`{}` is not a number", clip(s, 40)))?;
     if x.is_finite() { Ok(x) } else { Err(format!("{x} is not finite")) }
+}
+
+/// A B-spline degree for STEP faces: 3 or 5.
+fn spline_degree(s: &str) -> Result<usize, String> {
+    match s.trim() {
+        "3" => Ok(3),
+        "5" => Ok(5),
+        _ => Err(format!("`{s}`: the faces are of degree 3 or 5")),
+    }
 }
 
 /// A camera elevation in degrees.
@@ -417,7 +433,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
     let quiet = cli.quiet;
     let loader = |set, solver, terms: Option<u64>| Load { limits, set, solver, terms: terms.map(|t| t as usize) };
     match cli.command {
-        Command::Build { scene, out, set, tolerance, relative_tolerance } => {
+        Command::Build { scene, out, set, tolerance, relative_tolerance, degree } => {
             let sc = loader(&set, None, None).scene(&scene)?;
             // the condition check runs before anything is written: a scene that fails it
             // leaves no file (quiet: the check alone; otherwise the whole report, printed below)
@@ -435,16 +451,23 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 d
             };
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-            if (tolerance.is_some() || relative_tolerance.is_some()) && ext != "step" && ext != "stp" {
-                bail!("--tolerance and --relative-tolerance apply to STEP output only (-o FILE.step)");
+            if (tolerance.is_some() || relative_tolerance.is_some() || degree.is_some())
+                && ext != "step"
+                && ext != "stp"
+            {
+                bail!("--tolerance, --relative-tolerance and --degree apply to STEP output only (-o FILE.step)");
             }
             if ext == "step" || ext == "stp" {
                 if sc.patches.is_empty() {
                     bail!("the scene {} has no patches to write", sc.file);
                 }
-                let fitted =
-                    pdeshape_io::cad::fit_scene_relative(&sc, tolerance, relative_tolerance.unwrap_or(1e-6), None)
-                        .map_err(|e| anyhow!(e))?;
+                let o = pdeshape_io::cad::CadOptions {
+                    tolerance,
+                    relative: relative_tolerance.unwrap_or(1e-6),
+                    degree: degree.unwrap_or(3),
+                    time: None,
+                };
+                let fitted = pdeshape_io::cad::fit_scene(&sc, &o).map_err(|e| anyhow!(e))?;
                 pdeshape_io::cad::write_scene_step(&out, &sc, &fitted)
                     .with_context(|| format!("cannot write {}", out.display()))?;
                 if !quiet {
@@ -503,10 +526,11 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             }
             Ok(())
         }
-        Command::Check { scene, json, set, solver, cad } => {
+        Command::Check { scene, json, set, solver, cad, degree } => {
             let sc = loader(&set, solver.as_deref(), None).scene(&scene)?;
             let mut d = model::scene_diagnostics(&sc);
-            let fitted = if cad { Some(pdeshape_io::cad::fit_scene(&sc, None).map_err(|e| anyhow!(e))?) } else { None };
+            let o = pdeshape_io::cad::CadOptions { degree: degree.unwrap_or(3), ..Default::default() };
+            let fitted = if cad { Some(pdeshape_io::cad::fit_scene(&sc, &o).map_err(|e| anyhow!(e))?) } else { None };
             if let Some(f) = &fitted {
                 d["cad"] = cad_report(f);
             }
@@ -713,8 +737,8 @@ fn cad_lines(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<String> {
     for s in cad_seams(fitted) {
         let [(a, ua), (b, ub)] = s.faces;
         out.push(format!(
-            "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad ({} points, after export)",
-            fitted[a].name, fitted[b].name, s.gap, s.angle, s.samples
+            "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad, cross curvature gap {:.2e} ({} points, after export)",
+            fitted[a].name, fitted[b].name, s.gap, s.angle, s.curvature_gap, s.samples
         ));
     }
     out
@@ -765,7 +789,7 @@ fn cad_report(fitted: &[pdeshape_io::cad::CadFace]) -> serde_json::Value {
             let [(a, ua), (b, ub)] = s.faces;
             serde_json::json!({
                 "faces": [fitted[a].name, fitted[b].name], "u": [ua, ub],
-                "gap": s.gap, "normal_angle_radians": s.angle, "samples": s.samples,
+                "gap": s.gap, "normal_angle_radians": s.angle, "curvature_gap": s.curvature_gap, "samples": s.samples,
             })
         })
         .collect();

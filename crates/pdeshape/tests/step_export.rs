@@ -281,3 +281,44 @@ fn the_dolphins_fins_share_their_roots_with_the_body() {
         assert_ne!(hole.1, shared[0].1, "{fin}: the root edge runs the same way in both faces");
     }
 }
+
+/// `--degree 5`: the faces interpolate the second cross derivative at their ends as well,
+/// so the 6th-order (C2) blend of blend-cone-cylinder stays curvature-continuous with its
+/// cone and cylinder after export (cross curvature gap 5e-3 … 6e-3 bicubic, ~1e-13
+/// quintic, measured); the 4th-order blend, C1 only, keeps its curvature jump of order 1.
+/// Degrees other than 3 and 5 are usage errors; `--degree` with a mesh format is refused.
+#[test]
+fn degree_five_keeps_curvature_across_c2_seams() {
+    let seams = |degree: &str| -> Vec<serde_json::Value> {
+        let o = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+            .args(["check", "--cad", "--json", "--degree", degree])
+            .arg(example("blend-cone-cylinder.toml"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let d: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        d["cad"]["seams"].as_array().unwrap().clone()
+    };
+    let gap = |seams: &[serde_json::Value], face: &str| -> f64 {
+        let mine: Vec<f64> =
+            seams.iter().filter(|s| s["faces"][0] == face).map(|s| s["curvature_gap"].as_f64().unwrap()).collect();
+        assert_eq!(mine.len(), 2, "{face}: {seams:?}");
+        mine.into_iter().fold(0.0, |m, x| if x.is_nan() || x > m { x } else { m })
+    };
+    let (cubic, quintic) = (seams("3"), seams("5"));
+    assert!(gap(&cubic, "o6") > 1e-4, "{}", gap(&cubic, "o6"));
+    // round-off of second derivatives of the fitted faces (curvatures of order 1)
+    assert!(gap(&quintic, "o6") < 1e-10, "{}", gap(&quintic, "o6"));
+    assert!(gap(&quintic, "o4") > 0.1, "{}", gap(&quintic, "o4"));
+    for s in &quintic {
+        assert!(s["normal_angle_radians"].as_f64().unwrap() < 1.0, "{s}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = build(&example("bloor-wilson-blend.toml"), &dir.path().join("x.step"), &["--degree", "4"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("degree 3 or 5"));
+    let out = dir.path().join("x.obj");
+    let o = build(&example("bloor-wilson-blend.toml"), &out, &["--degree", "5"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("STEP output only") && !out.exists());
+}

@@ -229,6 +229,15 @@ fn fit_on(s: &dyn Surface, ku: &Knots, kv: &Knots) -> Result<BSplineSurface, Fit
         rows[nu - 2] = (1.0, 1);
         samples[1] = ends[..nv].iter().map(|x| x[1]).collect();
         samples[nu - 2] = ends[nv..].iter().map(|x| x[1]).collect();
+        // degree ≥ 5: the next rows interpolate X_uu too, so that faces meeting along an
+        // edge share their curvature across it as well (C2 / G2 survives the export)
+        if ku.degree >= 5 && nu >= 6 {
+            let ends = s.grid2(&[0.0, 1.0], &gv);
+            rows[2] = (0.0, 2);
+            rows[nu - 3] = (1.0, 2);
+            samples[2] = ends[..nv].iter().map(|x| x[3]).collect();
+            samples[nu - 3] = ends[nv..].iter().map(|x| x[3]).collect();
+        }
     }
     for (i, row) in samples.iter().enumerate() {
         if let Some(j) = row.iter().position(|p| !p.is_finite()) {

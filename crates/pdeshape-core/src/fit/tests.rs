@@ -123,3 +123,33 @@ fn a_crease_is_found_and_followed() {
     }
     assert!(worst <= r.max_deviation * (1.0 + 1e-9) && r.max_deviation <= 1e-12, "{worst} {r:?}");
 }
+
+/// Degree 5: the certificate holds as for degree 3 (random points within the certified
+/// maximum), the net is smaller at a tight tolerance, and the edges interpolate the
+/// patch's position, first and second cross derivatives exactly at the Greville points of
+/// `v` — the second derivative only in degree 5.
+#[test]
+fn quintic_faces_are_certified_and_interpolate_the_second_cross_derivative() {
+    let s = Sphere(1.0);
+    let tau = std::f64::consts::TAU;
+    let tol = 1e-8;
+    let (b3, r3) = fit_surface(&s, &FitOptions { tolerance: Some(tol), ..Default::default() }).unwrap();
+    let (b5, r5) = fit_surface(&s, &FitOptions { tolerance: Some(tol), degree: 5, ..Default::default() }).unwrap();
+    assert_eq!((b5.u.degree, b5.v.degree), (5, 5));
+    assert!(r5.max_deviation <= tol);
+    let worst =
+        points(4000, 0.0, tau).map(|(u, v)| (b5.point(u, v) - s.point(u, v)).norm()).fold(0.0, crate::num::max_nan);
+    assert!(worst <= r5.max_deviation * (1.0 + 1e-9), "random {worst} above the certificate {}", r5.max_deviation);
+    assert!(r5.points.0 * r5.points.1 < r3.points.0 * r3.points.1, "{:?} vs {:?}", r5.points, r3.points);
+    for (b, second) in [(&b3, false), (&b5, true)] {
+        for v in b.v.greville() {
+            for u in [0.0, 1.0] {
+                let (d, e) = (b.derivatives(u, v, 2, 0), s.derivatives(u, v, 2, 0));
+                assert!((d[0] - e[0]).norm() < 1e-13 && (d[1] - e[1]).norm() < 1e-12, "({u}, {v})");
+                // X_uu of the sphere is of size π²: round-off 1e-11
+                let err = (d[2] - e[2]).norm();
+                assert_eq!(err < 1e-11, second, "degree {}: X_uu at ({u}, {v}) off by {err}", b.u.degree);
+            }
+        }
+    }
+}

@@ -499,7 +499,10 @@ async fn export_route(
             // certified B-spline faces at the editor's time (inside the time limit: the
             // fit checks the cancel flag)
             None => {
-                let faces = pdeshape_io::cad::fit_scene_relative(&scene, None, 1e-6, req.time)?;
+                let faces = pdeshape_io::cad::fit_scene(
+                    &scene,
+                    &pdeshape_io::cad::CadOptions { time: req.time, ..Default::default() },
+                )?;
                 pdeshape_io::cad::step_bytes(&scene, &faces).map_err(|e| e.to_string())?
             }
         };
