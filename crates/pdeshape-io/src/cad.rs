@@ -2,7 +2,7 @@
 //! fitted by a certified B-spline surface (`pdeshape_core::fit`) and written as STEP; the
 //! seams between the fitted faces measured after the fit.
 
-use crate::export::{StepFace, write_atomic, write_step};
+use crate::export::{StepFace, StepHole, write_atomic, write_step};
 use crate::scene::Scene;
 use pdeshape_core::Vec3;
 use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_curve, fit_surface};
@@ -38,6 +38,8 @@ pub struct Hole {
     pub curve: pdeshape_core::fit::BSplineCurve3,
     /// Its certified deviation from the exact `S(C(t))`.
     pub deviation: f64,
+    /// `C(t)` in the face's `(u, v)` as a planar spline (`z = 0`), the edge's pcurve.
+    pub pcurve: pdeshape_core::fit::BSplineCurve3,
     /// The curve runs counter-clockwise in `(u, v)` (the face's inner loop runs it back).
     pub counter_clockwise: bool,
     /// The face (index) standing on the hole, whose boundary isocurve is the curve.
@@ -269,10 +271,27 @@ pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
                 let [u, v] = c.point(t);
                 surface.point(u, v)
             };
-            let (curve, deviation) = fit_curve(&image, 0.0, std::f64::consts::TAU, &corners, f.report.tolerance, 4000)
+            let tau = std::f64::consts::TAU;
+            let (curve, deviation) = fit_curve(&image, 0.0, tau, &corners, f.report.tolerance, 4000)
                 .map_err(|e| format!("patch `{}`, trim curve `{name}`: {e}", p.name))?;
+            // the pcurve: C(t) itself, a planar spline in (u, v), to the face's tolerance
+            // divided by the face's largest |S_u| + |S_v| along the curve (so that its image
+            // stays within about the tolerance)
+            let stretch = (0..512)
+                .map(|k| {
+                    let [u, v] = c.point(tau * k as f64 / 512.0);
+                    let d = surface.derivatives(u, v, 1, 1);
+                    d[2].norm() + d[1].norm()
+                })
+                .fold(0.0, max_nan);
+            let in_domain = |t: f64| {
+                let [u, v] = c.point(t);
+                Vec3::new(u, v, 0.0)
+            };
+            let (pcurve, _) = fit_curve(&in_domain, 0.0, tau, &corners, f.report.tolerance / stretch.max(1e-300), 4000)
+                .map_err(|e| format!("patch `{}`, trim curve `{name}` in (u, v): {e}", p.name))?;
             let counter_clockwise = region.orientation.get(i).is_none_or(|&o| o > 0.0);
-            f.holes.push(Hole { name: name.clone(), curve, deviation, counter_clockwise, root_of: None });
+            f.holes.push(Hole { name: name.clone(), curve, pcurve, deviation, counter_clockwise, root_of: None });
         }
     }
     share_roots(&mut out);
@@ -401,7 +420,11 @@ fn step_faces(faces: &[CadFace]) -> Vec<StepFace<'_>> {
         .map(|p| StepFace {
             name: &p.name,
             surface: &p.surface,
-            holes: p.holes.iter().map(|h| (&h.curve, h.counter_clockwise)).collect(),
+            holes: p
+                .holes
+                .iter()
+                .map(|h| StepHole { curve: &h.curve, pcurve: Some(&h.pcurve), counter_clockwise: h.counter_clockwise })
+                .collect(),
             outward: p.outward,
         })
         .collect()

@@ -322,3 +322,43 @@ fn degree_five_keeps_curvature_across_c2_seams() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("STEP output only") && !out.exists());
 }
+
+/// A hole's edge is a `SURFACE_CURVE`: the 3D curve (master) and, as its `PCURVE` on the
+/// trimmed face's surface, the trim curve in `(u, v)` — a planar B-spline with 2D points
+/// in a 2D parametric context (OCCT reads it back on the circle to 2.9e-7 in
+/// `crates/pdeshape-io/tests/occt`).
+#[test]
+fn a_hole_edge_carries_its_pcurve() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.step");
+    let o = build(&example("trim-circle.toml"), &out, &["-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let (defs, refs) = entities(&text);
+    assert!(refs.iter().all(|r| defs.contains_key(r)));
+    let face = defs.values().find(|b| b.starts_with("ADVANCED_FACE(")).unwrap();
+    let surface = refs_in(face).into_iter().find(|r| defs[r].starts_with("B_SPLINE_SURFACE_WITH_KNOTS(")).unwrap();
+    let pcurves: Vec<&String> = defs.values().filter(|b| b.starts_with("PCURVE(")).collect();
+    assert_eq!(pcurves.len(), 1);
+    let r = refs_in(pcurves[0]);
+    assert_eq!(r[0], surface, "the pcurve lies on the face's surface");
+    let rep = &defs[&r[1]];
+    assert!(rep.starts_with("DEFINITIONAL_REPRESENTATION("), "{rep}");
+    let rr = refs_in(rep);
+    assert!(defs[&rr[1]].contains("GEOMETRIC_REPRESENTATION_CONTEXT(2)PARAMETRIC_REPRESENTATION_CONTEXT()"));
+    let c2 = &defs[&rr[0]];
+    assert!(c2.starts_with("B_SPLINE_CURVE_WITH_KNOTS('',3,"), "{c2}");
+    for p in refs_in(c2) {
+        let pt = &defs[&p];
+        // CARTESIAN_POINT('',(u,v)): two coordinates
+        assert_eq!(pt.matches(',').count(), 2, "{pt}");
+    }
+    let sc: Vec<&String> = defs.values().filter(|b| b.starts_with("SURFACE_CURVE(")).collect();
+    assert_eq!(sc.len(), 1);
+    assert!(
+        sc[0].ends_with(".CURVE_3D.)")
+            && refs_in(sc[0])[1] == *defs.iter().find(|(_, b)| b.starts_with("PCURVE(")).unwrap().0
+    );
+    assert!(defs.values().any(|b| b.starts_with("EDGE_CURVE(")
+        && refs_in(b)[2] == *defs.iter().find(|(_, b)| b.starts_with("SURFACE_CURVE(")).unwrap().0));
+}

@@ -15,7 +15,7 @@ mod vtu;
 pub use gltf::write_glb;
 pub use obj::write_obj;
 pub use ply::write_ply;
-pub use step::{StepFace, write_step};
+pub use step::{StepFace, StepHole, write_step};
 pub use stl::write_stl;
 pub use vtu::{write_vtu_hex, write_vtu_surface};
 

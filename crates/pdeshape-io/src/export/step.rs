@@ -25,9 +25,10 @@
 //!   each direction);
 //! - corners closer than the uncertainty share their vertex;
 //! - holes (trim curves) are inner `FACE_BOUND`s of one closed edge each, run clockwise
-//!   in `(u, v)`; their 3D curves lie on the written surface (readers compute the
-//!   pcurves by projection) — or are the boundary of a face standing on the hole, whose
-//!   edge they then share (the dolphin's fins on its body).
+//!   in `(u, v)`; the edge is a `SURFACE_CURVE`: its 3D curve (the master; it lies on the
+//!   written surface, or is the boundary of a face standing on the hole, whose edge it then
+//!   is: the dolphin's fins on its body) and the trim curve in `(u, v)` as a `PCURVE` on
+//!   the trimmed face.
 //!
 //! Lengths are written in millimetres (a scene's unit becomes 1 mm); the uncertainty —
 //! the distance below which two points are one — is the caller's (the fit tolerance).
@@ -43,12 +44,22 @@ pub struct StepFace<'a> {
     pub name: &'a str,
     /// Its surface.
     pub surface: &'a BSplineSurface,
-    /// Inner boundaries (holes): closed space curves on the surface, each with whether it
-    /// runs counter-clockwise in the surface's `(u, v)`.
-    pub holes: Vec<(&'a BSplineCurve3, bool)>,
+    /// Inner boundaries (holes).
+    pub holes: Vec<StepHole<'a>>,
     /// A face of a solid: whether `S_u × S_v` points out of it (its closed shell is then
     /// oriented outward).
     pub outward: Option<bool>,
+}
+
+/// A hole of a face: a closed space curve on its surface.
+pub struct StepHole<'a> {
+    /// The edge's 3D curve.
+    pub curve: &'a BSplineCurve3,
+    /// The same curve in the face's `(u, v)` (a planar spline, `z = 0`): written as the
+    /// edge's `PCURVE` on the face.
+    pub pcurve: Option<&'a BSplineCurve3>,
+    /// Whether the curve runs counter-clockwise in the face's `(u, v)`.
+    pub counter_clockwise: bool,
 }
 
 /// STEP's REAL: shortest round-trip digits with a decimal point and an upper-case exponent.
@@ -115,6 +126,18 @@ impl Entities {
         self.add(&format!(
             "B_SPLINE_CURVE_WITH_KNOTS('',{},{},.UNSPECIFIED.,{closed},.F.,{m},{t},.UNSPECIFIED.)",
             k.degree,
+            Self::list(ids)
+        ))
+    }
+
+    /// A planar curve (`z` of the control points dropped) for a pcurve.
+    fn curve2d(&mut self, c: &BSplineCurve3) -> usize {
+        let ids: Vec<usize> =
+            c.control.iter().map(|p| self.add(&format!("CARTESIAN_POINT('',({},{}))", real(p.x), real(p.y)))).collect();
+        let (m, t) = Self::knots(&c.knots);
+        self.add(&format!(
+            "B_SPLINE_CURVE_WITH_KNOTS('',{},{},.UNSPECIFIED.,.F.,.F.,{m},{t},.UNSPECIFIED.)",
+            c.knots.degree,
             Self::list(ids)
         ))
     }
@@ -192,8 +215,12 @@ struct Topology {
 /// runs clockwise in the face's loop; a face standing on the hole shares its edge).
 fn all_sides<'a>(f: &'a StepFace, tol: f64) -> Vec<(usize, Side<'a>)> {
     let mut out = sides(f.surface, tol);
-    for (i, (c, ccw)) in f.holes.iter().enumerate() {
-        out.push((4 + i, Side { pts: c.control.clone(), knots: &c.knots, from: 0, to: 0, forward: !ccw }));
+    for (i, h) in f.holes.iter().enumerate() {
+        let c = h.curve;
+        out.push((
+            4 + i,
+            Side { pts: c.control.clone(), knots: &c.knots, from: 0, to: 0, forward: !h.counter_clockwise },
+        ));
     }
     out
 }
@@ -286,10 +313,36 @@ fn write_faces(e: &mut Entities, faces: &[StepFace], t: &Topology, tol: f64) -> 
         id
     };
     let mut edge_ids: Vec<Option<usize>> = vec![None; t.edges.len()];
+    let srfs: Vec<usize> = faces.iter().map(|f| e.surface(f.surface)).collect();
+    // hole edges first, so that the trimmed face's pcurve is on the edge even where a face
+    // standing on the hole comes first: one closed edge from and to the curve's start, its
+    // geometry the 3D curve (master) with the trim curve in (u, v) as the pcurve
+    let mut ctx2d = None;
+    for (fi, f) in faces.iter().enumerate() {
+        for (i, h) in f.holes.iter().enumerate() {
+            let ei = t.edge_of[fi].iter().find(|(kk, _)| *kk == 4 + i).expect("every hole has an edge").1;
+            if edge_ids[ei].is_some() {
+                continue;
+            }
+            let c = h.curve;
+            let start = vertex(e, c.control[0]);
+            let mut curve = e.curve(&c.control, &c.knots, tol);
+            if let Some(pc) = h.pcurve {
+                let ctx = *ctx2d.get_or_insert_with(|| {
+                    e.add("(GEOMETRIC_REPRESENTATION_CONTEXT(2)PARAMETRIC_REPRESENTATION_CONTEXT()REPRESENTATION_CONTEXT('2D SPACE',''))")
+                });
+                let c2 = e.curve2d(pc);
+                let rep = e.add(&format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx})"));
+                let pcurve = e.add(&format!("PCURVE('',#{},#{rep})", srfs[fi]));
+                curve = e.add(&format!("SURFACE_CURVE('',#{curve},(#{pcurve}),.CURVE_3D.)"));
+            }
+            edge_ids[ei] = Some(e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)")));
+        }
+    }
     let mut out = Vec::with_capacity(faces.len());
     for (fi, f) in faces.iter().enumerate() {
         let s = f.surface;
-        let srf = e.surface(s);
+        let srf = srfs[fi];
         let cs = corners(s);
         let sd = sides(s, tol);
         let mut loop_edges = Vec::new();
@@ -312,21 +365,11 @@ fn write_faces(e: &mut Entities, faces: &[StepFace], t: &Topology, tol: f64) -> 
         let sense = |b: bool| if b != t.flip[fi] { ".T." } else { ".F." };
         let lp = e.add(&format!("EDGE_LOOP('',{})", Entities::list(loop_edges)));
         let mut bounds = vec![e.add(&format!("FACE_OUTER_BOUND('',#{lp},{})", sense(true)))];
-        for (i, (c, ccw)) in f.holes.iter().enumerate() {
-            // one closed edge from and to the curve's start (shared with a face standing on
-            // the hole); an inner loop runs clockwise
+        for (i, h) in f.holes.iter().enumerate() {
+            // an inner loop runs clockwise
             let ei = t.edge_of[fi].iter().find(|(kk, _)| *kk == 4 + i).expect("every hole has an edge").1;
-            let edge = match edge_ids[ei] {
-                Some(id) => id,
-                None => {
-                    let start = vertex(e, c.control[0]);
-                    let curve = e.curve(&c.control, &c.knots, tol);
-                    let id = e.add(&format!("EDGE_CURVE('',#{start},#{start},#{curve},.T.)"));
-                    edge_ids[ei] = Some(id);
-                    id
-                }
-            };
-            let flag = if *ccw { ".F." } else { ".T." };
+            let edge = edge_ids[ei].expect("hole edges are written first");
+            let flag = if h.counter_clockwise { ".F." } else { ".T." };
             let oe = e.add(&format!("ORIENTED_EDGE('',*,*,#{edge},{flag})"));
             let lp = e.add(&format!("EDGE_LOOP('',(#{oe}))"));
             bounds.push(e.add(&format!("FACE_BOUND('',#{lp},{})", sense(true))));

@@ -229,6 +229,25 @@ def test_a_trimmed_patch_is_a_face_with_its_hole(tmp_path):
         assert state == (TopAbs_OUT if r < 0.22 else TopAbs_IN), (u, v, r)
         checked += 1
     assert checked > 300
+    # the hole's edge carries its pcurve: the trim circle in (u, v), to the face's
+    # tolerance over its largest |S_u| + |S_v| (about 1e-6 here)
+    from OCP.TopAbs import TopAbs_EDGE
+
+    ex = TopExp_Explorer(face, TopAbs_EDGE)
+    radii = []
+    while ex.More():
+        edge = TopoDS.Edge(ex.Current())
+        from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+
+        c2d = BRepAdaptor_Curve2d(edge, face)
+        pts = [c2d.Value(float(t)) for t in np.linspace(c2d.FirstParameter(), c2d.LastParameter(), 400)]
+        r = np.array([np.hypot(p.X() - 0.5, p.Y() - 0.5) for p in pts])
+        if abs(r.mean() - 0.22) < 0.01:
+            radii.append(r)
+        ex.Next()
+    assert len(radii) == 1
+    print(f"trim-circle pcurve: max |r − 0.22| = {np.abs(radii[0] - 0.22).max():.2e}")
+    assert np.abs(radii[0] - 0.22).max() <= 1e-5, np.abs(radii[0] - 0.22).max()
 
 
 # solid blends: the faces that bound them, each with the solid's parameters that are the
