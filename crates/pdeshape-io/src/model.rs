@@ -959,6 +959,10 @@ pub fn patch_diagnostics(p: &ScenePatch) -> Value {
             "modes_solved_in_f64": r.methods.0,
             "modes_solved_in_multiprecision": r.methods.1,
             "mode_paths": r.mode_paths,
+            // the truncated part's PDE residual, relative, from the modes' Chebyshev
+            // coefficients (every order; the last entry is the remainder's functions)
+            "mode_residuals_relative": r.mode_residuals,
+            "truncated_residual_relative": r.mode_residuals[..r.mode_residuals.len() - 1].iter().copied().max_nan(),
             "lebesgue_mode0": r.lebesgue.0,
         });
         let s = &mut d["spectral"];

@@ -644,7 +644,7 @@ fn print_check(sc: &Scene, d: &serde_json::Value) {
         let sp = &p["spectral"];
         if sp.is_object() {
             println!(
-                "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}",
+                "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}, truncated-part residual {:.1e} (relative)",
                 sp["order"],
                 sp["modes"],
                 sp["omega"],
@@ -652,6 +652,7 @@ fn print_check(sc: &Scene, d: &serde_json::Value) {
                 sp["modes_solved_in_f64"],
                 sp["modes_solved_in_multiprecision"],
                 sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
+                sp["truncated_residual_relative"].as_f64().unwrap_or(f64::NAN),
             );
         }
         if let Some(line) = continuity_line(p) {

@@ -38,4 +38,4 @@ pub use poly::{CLUSTER_TOL, PolyRoots, polynomial_from_roots, polynomial_roots};
 pub use precise::ChebCardinal;
 pub use set::{CardinalSet, F64_COND_LIMIT};
 pub use space::{CLUSTER_GAP, ExpSpace, Root};
-pub use ultraspherical::{ULTRA_COND_LIMIT, UltraCardinal};
+pub use ultraspherical::{ULTRA_COND_LIMIT, UltraCardinal, relative_residual};

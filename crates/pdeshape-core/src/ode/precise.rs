@@ -158,6 +158,9 @@ pub struct ChebCardinal {
     /// cardinal property must hold to round-off for every tabulated derivative order: a
     /// Chebyshev series of a high derivative is only accurate relative to its maximum.
     at_conditions: Vec<(f64, Vec<Vec<f64>>)>,
+    /// The worst relative ODE residual of the pieces' series
+    /// ([`super::ultraspherical::relative_residual`]).
+    residual: f64,
 }
 
 impl ChebCardinal {
@@ -261,7 +264,26 @@ impl ChebCardinal {
                     .collect();
                 at_conditions.push((cd.u, vals));
             }
-            return Ok(ChebCardinal { breaks, coef, kmax, dim: n, bits, max_inverse: max_inv, at_conditions });
+            let p = super::polynomial_from_roots(space.roots());
+            let mut residual = 0.0_f64;
+            for (pc, piece) in coef.iter().enumerate() {
+                let h = breaks[pc + 1] - breaks[pc];
+                let Some(first) = piece[0].first() else { continue };
+                let r = super::ultraspherical::operator_rows(&p, first.len(), h);
+                for c in &piece[0] {
+                    residual = crate::num::max_nan(residual, super::ultraspherical::residual_of(&r, c));
+                }
+            }
+            return Ok(ChebCardinal {
+                breaks,
+                coef,
+                kmax,
+                dim: n,
+                bits,
+                max_inverse: max_inv,
+                at_conditions,
+                residual,
+            });
         }
     }
 
@@ -294,7 +316,13 @@ impl ChebCardinal {
             .collect()
     }
 
-    /// Working precision used (bits).
+    /// The ODE residual of the cardinal functions, relative, in Chebyshev coefficients (the
+    /// worst function and piece).
+    pub fn residual(&self) -> f64 {
+        self.residual
+    }
+
+    /// Working precision of the solve, bits.
     pub fn bits(&self) -> usize {
         self.bits
     }

@@ -50,6 +50,19 @@ impl CardinalSet {
         }
     }
 
+    /// The ODE residual of the cardinal functions, relative to its terms: for Chebyshev
+    /// series (ultraspherical, multiple precision) computed in coefficient space through
+    /// the banded operators ([`super::ultraspherical::relative_residual`]); 0 for the
+    /// exponential basis, whose functions `uʲ e^{ru}` solve the ODE exactly for the roots
+    /// it is given (the symmetric operators' `±c` are exact).
+    pub fn residual(&self) -> f64 {
+        match self {
+            CardinalSet::Direct(_) => 0.0,
+            CardinalSet::Ultraspherical(c) => c.residual(),
+            CardinalSet::Tabulated(c) => c.residual(),
+        }
+    }
+
     /// Highest derivative order available (unbounded for the direct form).
     pub fn kmax(&self) -> usize {
         match self {

@@ -49,6 +49,8 @@ pub struct UltraCardinal {
     /// the solve makes them cardinal to round-off, while the differentiated series lose
     /// accuracy in high derivatives at the ends (`T_m^{(k)}(±1)` grows like `m^{2k}`).
     at_conditions: Vec<(f64, Vec<Vec<f64>>)>,
+    /// [`relative_residual`] of `P(D)` on the cardinal functions, the worst of them.
+    residual: f64,
 }
 
 /// `T_m^{(d)}(x)` for `m < count`, `d ≤ dmax`: `t[d][m]`, by
@@ -141,47 +143,7 @@ impl UltraCardinal {
         let n = space.dim();
         let p = super::polynomial_from_roots(space.roots()); // ascending, monic, degree n
         debug_assert_eq!(p.len(), n + 1);
-        // scales: term k has entries p_k 2^k 2^{k−1}(k−1)! · m; normalise by the largest
-        let logs: Vec<f64> = p
-            .iter()
-            .enumerate()
-            .map(|(k, pk)| if *pk == 0.0 { f64::NEG_INFINITY } else { pk.abs().log2() + k as f64 + log2_dk(k) })
-            .collect();
-        let top = logs.iter().copied().fold(f64::NEG_INFINITY, crate::num::max_nan);
-        let factor = |k: usize| if logs[k].is_finite() { p[k].signum() * (logs[k] - top).exp2() } else { 0.0 };
-        // Horner in the C^{(λ)} bases, (K + 2n) rows so that no conversion is truncated
-        let rows = size + 2 * n;
-        let mut r = vec![vec![0.0; size]; rows];
-        for (j, row) in r.iter_mut().enumerate().take(size) {
-            row[j] = factor(0);
-        }
-        for lam in 0..n {
-            // S_λ on every column: row j ← s1(j) row j + s2(j) row j+2
-            for j in 0..rows {
-                let (s1, s2) = if lam == 0 {
-                    (if j == 0 { 1.0 } else { 0.5 }, -0.5)
-                } else {
-                    let l = lam as f64;
-                    (l / (j as f64 + l), -l / (j as f64 + 2.0 + l))
-                };
-                let (head, tail) = r.split_at_mut(j + 1);
-                let row = &mut head[j];
-                match tail.get(1) {
-                    Some(below) => row.iter_mut().zip(below).for_each(|(x, b)| *x = s1 * *x + s2 * b),
-                    None => row.iter_mut().for_each(|x| *x *= s1),
-                }
-            }
-            // + p_{λ+1} 2^{λ+1} D_{λ+1}: entry (j, j + k) = 2^{k−1}(k−1)! (j + k), scaled
-            let k = lam + 1;
-            let f = factor(k);
-            if f != 0.0 {
-                for (j, row) in r.iter_mut().enumerate() {
-                    if j + k < size {
-                        row[j + k] += f * (j + k) as f64;
-                    }
-                }
-            }
-        }
+        let r = operator_rows(&p, size, 1.0);
         // the system: condition rows, then K − n operator rows, each scaled to unit maximum
         let mut a = Mat::<f64>::zeros(size, size);
         let mut b = Mat::<f64>::zeros(size, n);
@@ -252,7 +214,8 @@ impl UltraCardinal {
                 .collect();
             at_conditions.push((cd.u, rows));
         }
-        let out = UltraCardinal { coef, kmax, dim: n, cond, size, at_conditions };
+        let residual = base.iter().map(|c| residual_of(&r, c)).fold(0.0, crate::num::max_nan);
+        let out = UltraCardinal { coef, kmax, dim: n, cond, size, at_conditions, residual };
         // the cardinal property at the conditions, to round-off
         for (i, cd) in conds.iter().enumerate() {
             if cd.order > kmax {
@@ -313,6 +276,97 @@ impl UltraCardinal {
     pub fn terms(&self) -> usize {
         self.size
     }
+
+    /// The ODE residual of the cardinal functions, relative, in Chebyshev coefficients
+    /// ([`relative_residual`]; the worst function).
+    pub fn residual(&self) -> f64 {
+        self.residual
+    }
+}
+
+/// `P(D_u)` for `u` on an interval of length `h` (`x = 2(u − a)/h − 1`) as rows in the
+/// `C^{(n)}` basis acting on `K = size` Chebyshev-T coefficients, `K + 2n` rows so that no
+/// conversion is truncated, divided by the largest term's scale `2^top` (see the module
+/// docs: `P(D_u) = Σ_k p_k (2/h)^k D_x^k`, in Horner form over the conversions `S_λ`).
+pub fn operator_rows(p: &[f64], size: usize, h: f64) -> Vec<Vec<f64>> {
+    let n = p.len() - 1;
+    // scales: term k has entries p_k (2/h)^k 2^{k−1}(k−1)! · m; normalise by the largest
+    let logs: Vec<f64> =
+        p.iter()
+            .enumerate()
+            .map(|(k, pk)| {
+                if *pk == 0.0 { f64::NEG_INFINITY } else { pk.abs().log2() + k as f64 * (2.0 / h).log2() + log2_dk(k) }
+            })
+            .collect();
+    let top = logs.iter().copied().fold(f64::NEG_INFINITY, crate::num::max_nan);
+    let factor = |k: usize| if logs[k].is_finite() { p[k].signum() * (logs[k] - top).exp2() } else { 0.0 };
+    let rows = size + 2 * n;
+    let mut r = vec![vec![0.0; size]; rows];
+    for (j, row) in r.iter_mut().enumerate().take(size) {
+        row[j] = factor(0);
+    }
+    for lam in 0..n {
+        // S_λ on every column: row j ← s1(j) row j + s2(j) row j+2
+        for j in 0..rows {
+            let (s1, s2) = if lam == 0 {
+                (if j == 0 { 1.0 } else { 0.5 }, -0.5)
+            } else {
+                let l = lam as f64;
+                (l / (j as f64 + l), -l / (j as f64 + 2.0 + l))
+            };
+            let (head, tail) = r.split_at_mut(j + 1);
+            let row = &mut head[j];
+            match tail.get(1) {
+                Some(below) => row.iter_mut().zip(below).for_each(|(x, b)| *x = s1 * *x + s2 * b),
+                None => row.iter_mut().for_each(|x| *x *= s1),
+            }
+        }
+        // + p_{λ+1} (2/h)^{λ+1} D_{λ+1}: entry (j, j + k) = 2^{k−1}(k−1)! (j + k), scaled
+        let k = lam + 1;
+        let f = factor(k);
+        if f != 0.0 {
+            for (j, row) in r.iter_mut().enumerate() {
+                if j + k < size {
+                    row[j + k] += f * (j + k) as f64;
+                }
+            }
+        }
+    }
+    r
+}
+
+/// The residual of `P(D_u) ℓ = 0` for the Chebyshev series `c` of `ℓ` on an interval of
+/// length `h`, computed in coefficient space through the banded operators (no derivative
+/// is evaluated): `max_j |(R c)_j| / max_j (|R| |c|)_j` with `R` the operator in the
+/// `C^{(n)}` basis — the part of the operator's terms `p_k ℓ^{(k)}` that does not cancel,
+/// relative to the terms. Coefficients below `K ε ‖c‖∞` (the representation's round-off,
+/// which the operator would amplify into noise of its own size) are dropped first, so a
+/// function the operator annihilates exactly (a polynomial of degree `< 2N` under
+/// `D^{2N}`) gives 0. Exact solutions give round-off (`~1e-15`); a function solving a
+/// different ODE gives the ratio of its residual to its terms (`e^{au}` under
+/// `(D² − c²)^N`: `((a² − c²)/(a² + c²))^N`); the last rows, which the ultraspherical
+/// system leaves out, hold the truncation (tau) residual of a finite series.
+pub fn relative_residual(p: &[f64], h: f64, c: &[f64]) -> f64 {
+    residual_of(&operator_rows(p, c.len(), h), c)
+}
+
+/// [`relative_residual`] with the operator's rows built once for many series (all of
+/// length `r[0].len()`).
+pub fn residual_of(r: &[Vec<f64>], c: &[f64]) -> f64 {
+    let cn = c.iter().map(|x| x.abs()).fold(0.0, crate::num::max_nan);
+    let floor = c.len() as f64 * f64::EPSILON * cn;
+    let c: Vec<f64> = c.iter().map(|&x| if x.abs() <= floor { 0.0 } else { x }).collect();
+    let (mut res, mut size) = (0.0_f64, 0.0_f64);
+    for row in r {
+        let (mut x, mut a) = (0.0, 0.0);
+        for (rj, cj) in row.iter().zip(&c) {
+            x += rj * cj;
+            a += (rj * cj).abs();
+        }
+        res = crate::num::max_nan(res, x.abs());
+        size = crate::num::max_nan(size, a);
+    }
+    if size > 0.0 { res / size } else { res }
 }
 
 /// The series needs more terms.
@@ -365,6 +419,69 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Chebyshev coefficients (in `x = 2u − 1`) of `f` on `[0, 1]` by interpolation at
+    /// `n` Chebyshev points of the first kind (the discrete cosine sums).
+    fn interpolate(f: impl Fn(f64) -> f64, n: usize) -> Vec<f64> {
+        let pi = std::f64::consts::PI;
+        let vals: Vec<f64> = (0..n).map(|j| f((1.0 + (pi * (j as f64 + 0.5) / n as f64).cos()) / 2.0)).collect();
+        (0..n)
+            .map(|k| {
+                let s: f64 =
+                    vals.iter().enumerate().map(|(j, v)| v * (pi * k as f64 * (j as f64 + 0.5) / n as f64).cos()).sum();
+                s * if k == 0 { 1.0 } else { 2.0 } / n as f64
+            })
+            .collect()
+    }
+
+    /// The coefficient-space residual, against functions built independently of the
+    /// solver (interpolated from closed forms): exact solutions of `(D² − c²)^N` give
+    /// round-off, a function that solves a neighbouring ODE does not, and the cardinal
+    /// functions of order 40 solve theirs to round-off.
+    #[test]
+    fn coefficient_residuals_of_exact_and_wrong_solutions() {
+        // (from order 8 on an interpolant's ε-errors in high coefficients, amplified by D^2N,
+        // outweigh the terms: the solver's own series are checked below instead)
+        for (c, n) in [(0.0, 1usize), (3.0, 1), (3.0, 3)] {
+            let p = super::super::polynomial_from_roots(ExpSpace::symmetric(c, n).roots());
+            // u^{N−1} e^{cu} (an exact solution: root c of multiplicity N) and, for c = 0,
+            // a polynomial of degree 2N − 1
+            let k = (n - 1) as i32;
+            let exact = interpolate(|u| u.powi(k) * (c * u).exp(), 60);
+            let r = relative_residual(&p, 1.0, &exact);
+            // round-off of a 60-term interpolant: its coefficients carry errors of about
+            // ε ‖f‖ each, which the high derivatives amplify (measured up to 3.5e-13)
+            assert!(r < 1e-11, "c = {c}, N = {n}: exact solution's residual {r:e}");
+            // e^{(c + 2) u} solves a neighbouring ODE (roots ±(c + 2)), not this one: its
+            // residual relative to its terms is ((a² − c²)/(a² + c²))^N, a = c + 2
+            let a = c + 2.0;
+            let wrong = interpolate(|u| (a * u).exp(), 60);
+            let w = relative_residual(&p, 1.0, &wrong);
+            let want = ((a * a - c * c) / (a * a + c * c)).powi(n as i32);
+            assert!(w > 0.01 * want, "c = {c}, N = {n}: a wrong solution's residual {w:e}, expected about {want:e}");
+        }
+        // on a piece of length h the derivatives scale by 2/h: e^{5u} on [0, 0.2] is
+        // e^{x/2}·const in x, which solves (D_u² − 25) only with the scaling
+        let p = super::super::polynomial_from_roots(ExpSpace::symmetric(5.0, 1).roots());
+        let piece = interpolate(|t| (5.0 * 0.2 * t).exp(), 40);
+        assert!(relative_residual(&p, 0.2, &piece) < 1e-13);
+        assert!(relative_residual(&p, 1.0, &piece) > 1e-3);
+        // the Klein bottle's order: cardinal functions of (D² − c²)^20 at 40 Chebyshev nodes
+        let nodes: Vec<CondSpec> = (0..40)
+            .map(|i| CondSpec { u: (1.0 - (std::f64::consts::PI * i as f64 / 39.0).cos()) / 2.0, order: 0 })
+            .collect();
+        for c in [0.0, 1.4, 7.0] {
+            let u = UltraCardinal::new(&ExpSpace::symmetric(c, 20), &nodes, 2).unwrap();
+            // measured 5.7e-12 at c = 1.4 (the Klein bottle's own modes: 4.6e-16)
+            assert!(u.residual() < 1e-10, "c = {c}: {:e}", u.residual());
+            // the same series with a 1e-10 error in one coefficient no longer solves it
+            let mut bad = u.coef[0][7].clone();
+            bad[45] += 1e-10 * bad.iter().map(|x| x.abs()).fold(0.0, f64::max);
+            let p = super::super::polynomial_from_roots(ExpSpace::symmetric(c, 20).roots());
+            let r = relative_residual(&p, 1.0, &bad);
+            assert!(r > 1e3 * u.residual().max(1e-16), "c = {c}: a perturbed series' residual {r:e}");
         }
     }
 }

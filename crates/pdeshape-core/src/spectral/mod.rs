@@ -126,6 +126,13 @@ pub struct SpectralReport {
     /// The path of every mode `0 … M` and then of the remainder (`"f64"`,
     /// `"f64-ultraspherical"`, `"multiprecision"`).
     pub mode_paths: Vec<&'static str>,
+    /// The ODE residual of every mode's cardinal functions (`0 … M`, then the remainder's),
+    /// relative to the operator's terms, computed in Chebyshev coefficients through the
+    /// banded operators for every order ([`crate::ode::CardinalSet::residual`]; 0 for
+    /// the exact exponential basis). The truncated part `X̃ = Σ_m U_m(u) e^{imθ}` has PDE
+    /// residual `Σ_m P_m(D)U_m e^{imθ}`, so the largest mode figure bounds its relative
+    /// residual.
+    pub mode_residuals: Vec<f64>,
     /// Lebesgue constants of the condition set for mode 0 and mode 1 (amplification of
     /// the data between the conditions).
     pub lebesgue: (f64, Option<f64>),
@@ -267,6 +274,7 @@ impl SpectralPatch {
             max_mode_condition,
             methods: (self.cards.len() - mp, mp),
             mode_paths: self.cards.iter().chain(std::iter::once(&self.rem)).map(|c| c.method()).collect(),
+            mode_residuals: self.cards.iter().chain(std::iter::once(&self.rem)).map(|c| c.residual()).collect(),
             lebesgue: (self.cards[0].lebesgue(400), self.cards.get(1).map(|c| c.lebesgue(400))),
         }
     }
