@@ -37,6 +37,8 @@ pub struct ScalingOptions {
     pub runs: usize,
     /// Largest grid side (the study goes 50, 100, 200, 500, 1000, 2000 up to it).
     pub max_side: usize,
+    /// The caps every scene of the study is resolved under (`--limit`).
+    pub limits: pdeshape_core::limits::Limits,
 }
 
 fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
@@ -44,9 +46,10 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
 }
 
 /// Parses `text`, with the parameter `a` set when given.
-fn parse(text: &str, a: Option<f64>) -> Result<Scene, String> {
+fn parse(text: &str, a: Option<f64>, limits: pdeshape_core::limits::Limits) -> Result<Scene, String> {
     let opts = LoadOptions {
         params: a.map(|a| HashMap::from([("a".to_string(), a)])).unwrap_or_default(),
+        limits,
         ..Default::default()
     };
     Scene::parse_with(text, "scaling.toml", "scaling", &opts).map_err(|e| e.to_string())
@@ -60,6 +63,7 @@ fn solve_and_mesh(
     side: usize,
     runs: usize,
     threads: usize,
+    limits: pdeshape_core::limits::Limits,
 ) -> Result<(Timing, Timing, usize), String> {
     // one counter for the whole process: no two solves share an `a`, whatever the thread
     // count or study
@@ -68,14 +72,14 @@ fn solve_and_mesh(
         let mut err = None;
         let solve = time(runs, || {
             let k = RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if let Err(e) = parse(text, vary_a.then_some(1.0 + 1e-9 * k as f64)) {
+            if let Err(e) = parse(text, vary_a.then_some(1.0 + 1e-9 * k as f64), limits) {
                 err = Some(e);
             }
         });
         if let Some(e) = err {
             return Err(e);
         }
-        let scene = parse(text, None)?;
+        let scene = parse(text, None, limits)?;
         let s = scene.patches[0].surface.clone();
         let opts = GridOptions::new(side, side);
         let m = grid_mesh(s.as_ref(), &opts).map_err(|e| e.to_string())?;
@@ -130,7 +134,7 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ScalingRow>, String> {
     let mut rows = Vec::new();
-    let base = parse(four_curve_text, None)?;
+    let base = parse(four_curve_text, None, o.limits)?;
     let surface = base.patches[0].surface.clone();
     for side in [50, 100, 200, 500, 1000, 2000].into_iter().filter(|&s| s <= o.max_side) {
         for threads in [1, 2] {
@@ -158,7 +162,7 @@ pub fn run(
         for threads in [1, 2] {
             progress(&format!("order {count} on {threads} thread(s)"));
             let runs = if count > 10 { 3 } else { o.runs.min(7) };
-            let (solve, mesh, bytes) = solve_and_mesh(&sections(count), true, 100, runs, threads)?;
+            let (solve, mesh, bytes) = solve_and_mesh(&sections(count), true, 100, runs, threads, o.limits)?;
             rows.push(ScalingRow { study: "order", size: count, threads, solve: Some(solve), mesh, mesh_bytes: bytes });
         }
     }
@@ -166,7 +170,8 @@ pub fn run(
         for threads in [1, 2] {
             progress(&format!("modes {modes} on {threads} thread(s)"));
             let runs = o.runs.min(7);
-            let (solve, mesh, bytes) = solve_and_mesh(&four_curve(four_curve_text, modes), true, 100, runs, threads)?;
+            let (solve, mesh, bytes) =
+                solve_and_mesh(&four_curve(four_curve_text, modes), true, 100, runs, threads, o.limits)?;
             rows.push(ScalingRow { study: "modes", size: modes, threads, solve: Some(solve), mesh, mesh_bytes: bytes });
         }
     }
@@ -174,7 +179,8 @@ pub fn run(
         for threads in [1, 2] {
             progress(&format!("collocation {l} × {} on {threads} thread(s)", 3 * l));
             let runs = if l >= 64 { 3 } else { o.runs.min(7) };
-            let (solve, mesh, bytes) = solve_and_mesh(&collocation(blend_text, l), false, 100, runs, threads)?;
+            let (solve, mesh, bytes) =
+                solve_and_mesh(&collocation(blend_text, l), false, 100, runs, threads, o.limits)?;
             let size = 3 * l * l;
             rows.push(ScalingRow { study: "collocation", size, threads, solve: Some(solve), mesh, mesh_bytes: bytes });
         }
@@ -343,11 +349,11 @@ mod tests {
     fn study_scenes_parse() {
         let four = include_str!("../../../examples/four-curve-patch.toml");
         let blend = include_str!("../../../examples/blend-torus-hyperboloid.toml");
-        let s = parse(&four_curve(four, 3), Some(1.2)).unwrap();
+        let s = parse(&four_curve(four, 3), Some(1.2), Default::default()).unwrap();
         assert_eq!(s.patches[0].spectral.as_ref().unwrap().options().modes, 3);
-        let s = parse(&sections(6), Some(1.0)).unwrap();
+        let s = parse(&sections(6), Some(1.0), Default::default()).unwrap();
         assert_eq!(s.patches[0].conditions.len(), 6);
-        let s = parse(&collocation(blend, 8), None).unwrap();
+        let s = parse(&collocation(blend, 8), None, Default::default()).unwrap();
         assert_eq!(s.patches.len(), 1);
     }
 }

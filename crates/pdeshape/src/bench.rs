@@ -2,28 +2,29 @@
 
 use crate::EXAMPLES;
 use anyhow::{Result, anyhow};
+use pdeshape_core::limits::Limits;
 use pdeshape_io::scene::Scene;
 use pdeshape_io::tables::{self, AccuracyRow, Table1Row, TrimTableRow};
 use serde_json::json;
-use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-fn example(name: &str) -> Result<Scene> {
+fn example(name: &str, limits: Limits) -> Result<Scene> {
     let text =
         EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))?;
-    Ok(Scene::parse(text, &format!("examples/{name}.toml"), name, &HashMap::new())?)
+    let opts = pdeshape_io::scene::LoadOptions { limits, ..Default::default() };
+    Ok(Scene::parse_with(text, &format!("examples/{name}.toml"), name, &opts)?)
 }
 
 /// Runs every table; prints Markdown (or JSON) and optionally writes both next to `out`.
-pub fn run(runs: usize, json_out: bool, out: Option<&Path>) -> Result<()> {
-    let scene = example("dynamic-elliptic-cylinders")?;
+pub fn run(runs: usize, json_out: bool, out: Option<&Path>, limits: Limits) -> Result<()> {
+    let scene = example("dynamic-elliptic-cylinders", limits)?;
     let (t1, acc) = tables::on_one_thread(|| -> Result<(Vec<Table1Row>, Vec<AccuracyRow>), String> {
         Ok((tables::dynamic_table1(&scene, runs)?, tables::dynamic_accuracy(&scene)?))
     })
     .map_err(|e| anyhow!(e))?
     .map_err(|e| anyhow!(e))?;
-    let trim_scene = example("trim-circle")?;
+    let trim_scene = example("trim-circle", limits)?;
     let t3 = tables::on_one_thread(|| tables::trim_table1(&trim_scene, runs.max(5)))
         .map_err(|e| anyhow!(e))?
         .map_err(|e| anyhow!(e))?;
@@ -51,12 +52,12 @@ pub fn run(runs: usize, json_out: bool, out: Option<&Path>) -> Result<()> {
 }
 
 /// The scaling study: `scaling.md`, `scaling.json` and four plots in `dir`.
-pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool) -> Result<()> {
+pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool, limits: Limits) -> Result<()> {
     use pdeshape_io::scaling;
     let text = |name: &str| {
         EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))
     };
-    let o = scaling::ScalingOptions { runs, max_side };
+    let o = scaling::ScalingOptions { runs, max_side, limits };
     let rows = scaling::run(text("four-curve-patch")?, text("blend-torus-hyperboloid")?, o, |what| {
         if !quiet {
             eprintln!("scaling: {what}");

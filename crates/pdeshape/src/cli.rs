@@ -615,9 +615,11 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             }
             Ok(())
         }
-        Command::Gallery { dir } => crate::gallery::run(&dir, quiet),
-        Command::Bench { scaling: Some(dir), runs, max_side, .. } => crate::bench::scaling(&dir, runs, max_side, quiet),
-        Command::Bench { json, runs, out, .. } => crate::bench::run(runs, json, out.as_deref()),
+        Command::Gallery { dir } => crate::gallery::run(&dir, quiet, limits),
+        Command::Bench { scaling: Some(dir), runs, max_side, .. } => {
+            crate::bench::scaling(&dir, runs, max_side, quiet, limits)
+        }
+        Command::Bench { json, runs, out, .. } => crate::bench::run(runs, json, out.as_deref(), limits),
         Command::Serve { scene, port, host, open: _, time_limit } => crate::serve::run(crate::serve::ServeOptions {
             scene,
             host,

@@ -5,7 +5,6 @@ use anyhow::{Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use pdeshape_io::model;
 use pdeshape_io::scene::Scene;
-use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -25,7 +24,7 @@ fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
+fn build_one(name: &str, text: &str, dir: &Path, limits: pdeshape_core::limits::Limits) -> Entry {
     let mut e = Entry {
         name: name.to_string(),
         title: name.to_string(),
@@ -37,7 +36,8 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
         diagnostics: String::new(),
         error: None,
     };
-    let scene = match Scene::parse(text, &format!("examples/{name}.toml"), name, &HashMap::new()) {
+    let opts = pdeshape_io::scene::LoadOptions { limits, ..Default::default() };
+    let scene = match Scene::parse_with(text, &format!("examples/{name}.toml"), name, &opts) {
         Ok(s) => s,
         Err(err) => {
             e.error = Some(err.to_string());
@@ -140,7 +140,7 @@ fn build_one(name: &str, text: &str, dir: &Path) -> Entry {
 }
 
 /// Builds the gallery; fails (after building the rest) when any example fails.
-pub fn run(dir: &Path, quiet: bool) -> Result<()> {
+pub fn run(dir: &Path, quiet: bool, limits: pdeshape_core::limits::Limits) -> Result<()> {
     std::fs::create_dir_all(dir)?;
     let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(EXAMPLES.len() as u64) };
     bar.set_style(
@@ -149,7 +149,7 @@ pub fn run(dir: &Path, quiet: bool) -> Result<()> {
     let mut entries = Vec::new();
     for (name, text) in EXAMPLES {
         bar.set_message(name.to_string());
-        entries.push(build_one(name, text, dir));
+        entries.push(build_one(name, text, dir, limits));
         bar.inc(1);
     }
     bar.finish_and_clear();

@@ -226,3 +226,16 @@ fn render_views() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("unknown view `stripes` (one of: shaded, zebra, isophotes, gauss, mean, k1, k2)"), "{err}");
 }
+
+/// `--limit` holds for the commands that load the built-in examples themselves (`bench`,
+/// `gallery`): they resolved them with the default caps before, so a lowered cap let them
+/// solve what it forbids.
+#[test]
+fn bench_keeps_the_limits_it_is_given() {
+    let o =
+        Command::cargo_bin("pdeshape").unwrap().args(["bench", "--limit", "order=2", "--runs", "1"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("over the `order` cap of 2") && !err.contains("panicked"), "{err}");
+    assert!(o.stdout.is_empty(), "no table printed");
+}

@@ -736,6 +736,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
         render,
         formats,
         studies,
+        options: opts.clone(),
     })
 }
 

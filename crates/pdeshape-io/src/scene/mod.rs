@@ -380,6 +380,9 @@ pub struct Scene {
     pub formats: Vec<String>,
     /// Parameter studies (`[[studies]]`).
     pub studies: Vec<Study>,
+    /// The options it was resolved with (re-solves — parameter studies — keep its caps,
+    /// solver and terms).
+    pub options: LoadOptions,
 }
 
 /// Reads a scene file: a regular file (not a device, FIFO or directory: `/dev/zero` would

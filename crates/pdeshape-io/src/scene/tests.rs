@@ -70,3 +70,14 @@ fn parameters_keep_file_order() {
     let s = parse(BASE);
     assert_eq!(s.params.keys().collect::<Vec<_>>(), ["r", "d", "h"]);
 }
+
+/// A scene keeps the options it was resolved with, so that re-solves (parameter studies)
+/// keep its caps, solver and terms.
+#[test]
+fn a_scene_carries_its_load_options() {
+    let limits = pdeshape_core::limits::Limits { order: 12, ..Default::default() };
+    let opts = LoadOptions { limits, solver: Some("collocation".into()), ..Default::default() };
+    let sc = Scene::parse_with(BASE, "t", "t", &opts).unwrap();
+    assert_eq!(sc.options.limits, limits);
+    assert_eq!(sc.options.solver.as_deref(), Some("collocation"));
+}
