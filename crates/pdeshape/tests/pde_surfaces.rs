@@ -102,6 +102,9 @@ fn klein_bottle_is_exact_in_f64_across_the_slider() {
         for (m, r) in rep.mode_residuals.iter().enumerate() {
             assert!(*r <= 1e-9, "a = {a}, mode {m}: residual {r:e} ({})", rep.mode_paths[m]);
         }
+        // derivative orders beyond the tabulated ones are derived, not a panic
+        let deep = scene.patches[0].surface.derivatives(0.37, 1.1, 4, 1);
+        assert!(deep.len() == 10 && deep.iter().all(|x| x.is_finite()), "a = {a}");
         let d = model::patch_diagnostics(&scene.patches[0]);
         let t = d["spectral"]["truncated_residual_relative"].as_f64().unwrap();
         assert!(t <= 1e-9, "a = {a}: {t:e}");

@@ -244,9 +244,22 @@ impl UltraCardinal {
         Ok(Ok(out))
     }
 
-    /// `out[k][i] = ℓ_i^{(k)}(u)`, `k ≤ kmax` (at most the tabulated order).
+    /// `out[k][i] = ℓ_i^{(k)}(u)`, `k ≤ kmax`; orders above the tabulated ones are
+    /// differentiated from the highest tabulated series on demand.
     pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
-        assert!(kmax <= self.kmax, "derivative order {kmax} not tabulated (max {})", self.kmax);
+        if kmax > self.kmax {
+            // orders beyond the table: their series by differentiating the highest
+            // tabulated one (exact in coefficient arithmetic; `Surface::derivatives`
+            // promises any order, and a deep request must not panic)
+            let mut rows = self.eval(u, self.kmax);
+            let mut series = self.coef[self.kmax].clone();
+            let tj = chebyshev_derivatives(2.0 * u - 1.0, self.size.max(2), 0).swap_remove(0);
+            for _ in self.kmax..kmax {
+                series = series.iter().map(|c| differentiate(c).into_iter().map(|x| 2.0 * x).collect()).collect();
+                rows.push(series.iter().map(|c| crate::num::dot(c, &tj)).collect());
+            }
+            return rows;
+        }
         if let Some((_, rows)) = self.at_conditions.iter().find(|(c, _)| *c == u) {
             return rows[..=kmax].to_vec();
         }
@@ -482,6 +495,27 @@ mod tests {
             let p = super::super::polynomial_from_roots(ExpSpace::symmetric(c, 20).roots());
             let r = relative_residual(&p, 1.0, &bad);
             assert!(r > 1e3 * u.residual().max(1e-16), "c = {c}: a perturbed series' residual {r:e}");
+        }
+    }
+
+    /// Orders above the table are differentiated on demand instead of panicking; the ODE
+    /// itself checks them: for `(D² − c²)²`, `ℓ⁗ = 2c² ℓ″ − c⁴ ℓ`.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // i indexes every derivative row of d
+    fn derivatives_beyond_the_table_satisfy_the_ode() {
+        let c: f64 = 2.5;
+        let conds = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)].map(|(u, order)| CondSpec { u, order });
+        let card = UltraCardinal::new(&ExpSpace::symmetric(c, 2), &conds, 2).unwrap();
+        assert_eq!(card.kmax(), 2);
+        for u in [0.0, 0.13, 0.5, 0.91, 1.0] {
+            let d = card.eval(u, 4);
+            assert_eq!(d.len(), 5);
+            for i in 0..4 {
+                let want = 2.0 * c * c * d[2][i] - c.powi(4) * d[0][i];
+                let scale = (2.0 * c * c * d[2][i]).abs() + (c.powi(4) * d[0][i]).abs() + 1.0;
+                // series differentiated twice: round-off grows like the terms' size K⁴ε
+                assert!((d[4][i] - want).abs() <= 1e-9 * scale, "u = {u}, ℓ_{i}: {} vs {want}", d[4][i]);
+            }
         }
     }
 }
