@@ -327,7 +327,7 @@ fn best_position(p: &[Uv], cols: usize, reflex: &[Option<Uv>], i: usize, j: usiz
             }
         }
     }
-    let scale = f.iter().map(|(g, _)| g[0].abs() + g[1].abs()).fold(0.0, f64::max);
+    let scale = f.iter().map(|(g, _)| g[0].abs() + g[1].abs()).fold(0.0, crate::num::max_nan);
     if !(scale > 0.0 && scale.is_finite()) {
         return None;
     }
