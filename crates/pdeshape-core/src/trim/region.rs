@@ -75,6 +75,10 @@ pub struct TrimRegion {
     /// polygonisation): closer than this to the polygon, [`in_hole`](Self::in_hole)
     /// judges by the curve itself.
     pub sagitta: Vec<f64>,
+    /// Per curve, the bounding box `[min, max]` of its polygon: a point farther than the
+    /// sagitta (and the tolerance) from it is neither in the hole nor near it, which
+    /// [`in_hole`](Self::in_hole) decides without walking the polygon.
+    pub bounds: Vec<[Uv; 2]>,
     /// Bridges `(curve a, t_a, curve b, t_b)` joining the curves into one loop.
     pub bridges: Vec<(usize, f64, usize, f64)>,
     /// The loop: every curve once counter-clockwise, every bridge twice.
@@ -151,12 +155,21 @@ impl TrimRegion {
             }
         }
         let center = [cx[0] / total, cx[1] / total];
+        let bounds = polygons
+            .iter()
+            .map(|poly| {
+                poly.iter().fold([[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]], |[lo, hi], q| {
+                    [[lo[0].min(q[0]), lo[1].min(q[1])], [hi[0].max(q[0]), hi[1].max(q[1])]]
+                })
+            })
+            .collect();
         let mut region = TrimRegion {
             domain,
             curves,
             polygons,
             orientation,
             sagitta,
+            bounds,
             bridges: vec![],
             pieces: vec![],
             area,
@@ -354,6 +367,13 @@ impl TrimRegion {
     /// there the side of the curve's tangent at the closest point decides.
     pub fn in_hole(&self, p: Uv, tol: f64) -> bool {
         (0..self.polygons.len()).any(|i| {
+            // outside the box grown by the margin: farther than it from the polygon, and
+            // outside the polygon (a NaN point fails these tests and is judged below)
+            let [lo, hi] = self.bounds[i];
+            let m = self.sagitta[i].max(tol);
+            if p[0] < lo[0] - m || p[0] > hi[0] + m || p[1] < lo[1] - m || p[1] > hi[1] + m {
+                return false;
+            }
             let poly = &self.polygons[i];
             let d = super::curve::distance_to_polygon(p, poly);
             if tol > 0.0 && d < tol {
