@@ -27,6 +27,7 @@
 use super::{CondSpec, ExpSpace, OdeError};
 use faer::Mat;
 use faer::linalg::solvers::Solve;
+use std::sync::OnceLock;
 
 /// Largest condition number of the row-scaled ultraspherical system that is accepted: the
 /// same bound as the exponential basis's (errors up to about `cond × ε` ≈ 1e-12). Value
@@ -49,8 +50,11 @@ pub struct UltraCardinal {
     /// the solve makes them cardinal to round-off, while the differentiated series lose
     /// accuracy in high derivatives at the ends (`T_m^{(k)}(±1)` grows like `m^{2k}`).
     at_conditions: Vec<(f64, Vec<Vec<f64>>)>,
-    /// [`relative_residual`] of `P(D)` on the cardinal functions, the worst of them.
-    residual: f64,
+    /// The characteristic polynomial (ascending, monic), for the residual.
+    p: Vec<f64>,
+    /// [`relative_residual`] of `P(D)` on the cardinal functions, the worst of them;
+    /// computed on first use.
+    residual: OnceLock<f64>,
 }
 
 /// `T_m^{(d)}(x)` for `m < count`, `d ≤ dmax`: `t[d][m]`, by
@@ -214,8 +218,9 @@ impl UltraCardinal {
                 .collect();
             at_conditions.push((cd.u, rows));
         }
-        let residual = base.iter().map(|c| residual_of(&r, c)).fold(0.0, crate::num::max_nan);
-        let out = UltraCardinal { coef, kmax, dim: n, cond, size, at_conditions, residual };
+        // the residual is a diagnostic, computed when a report asks for it (dense in the
+        // K + 2n operator rows: a tenth of a Klein-bottle solve when done here)
+        let out = UltraCardinal { coef, kmax, dim: n, cond, size, at_conditions, p, residual: OnceLock::new() };
         // the cardinal property at the conditions, to round-off
         for (i, cd) in conds.iter().enumerate() {
             if cd.order > kmax {
@@ -293,7 +298,10 @@ impl UltraCardinal {
     /// The ODE residual of the cardinal functions, relative, in Chebyshev coefficients
     /// ([`relative_residual`]; the worst function).
     pub fn residual(&self) -> f64 {
-        self.residual
+        *self.residual.get_or_init(|| {
+            let r = operator_rows(&self.p, self.size, 1.0);
+            self.coef[0].iter().map(|c| residual_of(&r, c)).fold(0.0, crate::num::max_nan)
+        })
     }
 }
 
