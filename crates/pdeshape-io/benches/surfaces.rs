@@ -4,7 +4,7 @@
 //! example 2 (solve at L = M = N = 6, evaluation at 64³).
 //!
 //! One thread (the global rayon pool is built with one worker: the SPEC targets are for one
-//! core), and nothing memoised between iterations of a solve: each iteration changes a
+//! core; `PDESHAPE_BENCH_THREADS=2` for the two-thread tables), and nothing memoised between iterations of a solve: each iteration changes a
 //! parameter by a hair, so the cardinal functions (memoised across solves by their rates)
 //! are computed anew every time.
 //!
@@ -35,7 +35,9 @@ fn fresh(base: f64) -> impl FnMut() -> f64 {
 }
 
 fn surfaces(c: &mut Criterion) {
-    rayon::ThreadPoolBuilder::new().num_threads(1).build_global().expect("one worker thread");
+    // one worker unless PDESHAPE_BENCH_THREADS asks for more (the two-thread tables)
+    let threads = std::env::var("PDESHAPE_BENCH_THREADS").ok().and_then(|t| t.parse().ok()).unwrap_or(1);
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().expect("the worker threads");
     let bw = load("bloor-wilson-blend.toml");
     let four = load("four-curve-patch.toml");
     let klein = load("klein-bottle.toml");
@@ -82,6 +84,35 @@ fn surfaces(c: &mut Criterion) {
             let s = Scene::parse(&klein_text, "k", "k", &params).unwrap();
             let p = s.patches[0].spectral.clone().expect("a PDE patch");
             grid_mesh(p.as_ref(), &GridOptions::new(200, 200)).expect("finite")
+        })
+    });
+    // SPEC §10 / issue 16: the 4th-order four-curve patch (M = 6 + remainder) from its text,
+    // solved for a new `a` and meshed at 100 × 100 with normals (target 0.3 ms), and the
+    // same patch with M = 256 modes (target 50 ms)
+    let four_text =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/four-curve-patch.toml"))
+            .unwrap();
+    for (label, modes) in [("M=6", 6), ("M=256", 256)] {
+        let text = four_text.replace("kind = \"pde\"", &format!("kind = \"pde\"\nmodes = {modes}"));
+        assert_ne!(text, four_text);
+        let mut fa = fresh(1.1);
+        g.bench_function(format!("four-curve {label}: solve (new a) + 100x100 with normals"), |b| {
+            b.iter(|| {
+                let params = std::collections::HashMap::from([("a".to_string(), fa())]);
+                let s = Scene::parse(&text, "f", "f", &params).unwrap();
+                grid_mesh(s.patches[0].surface.as_ref(), &GridOptions::new(100, 100)).expect("finite")
+            })
+        });
+    }
+    // issue 16: the dolphin scene, cold (memo of cardinal functions emptied): parse, solve
+    // every patch, every patch's mesh at its scene resolution (trimmed body included)
+    let dolphin_text =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/dolphin.toml")).unwrap();
+    g.bench_function("dolphin: cold build to meshes", |b| {
+        b.iter(|| {
+            pdeshape_core::spectral::clear_cardinal_memo();
+            let s = Scene::parse(&dolphin_text, "d", "d", &Default::default()).unwrap();
+            pdeshape_io::model::patch_meshes(&s).unwrap()
         })
     });
     // N-sided fills (issue 21 target: fill + 100 × 100 with normals ≤ 2 ms): the three

@@ -25,16 +25,31 @@ fn header(body: &[u8]) -> Value {
     serde_json::from_slice(&body[4..4 + n]).unwrap()
 }
 
-/// `clients` threads each send `changes` values of `param`; returns the latencies (ms).
-fn load(url: &str, text: &str, param: &str, values: &[f64], clients: usize, changes: usize) -> Vec<f64> {
+/// The values client `c` sends, `changes` of them: `lo + (hi − lo)·frac(k φ)` over the
+/// clients' joint sequence, so no two requests carry the same value and no solve is served
+/// by the process-wide memo of cardinal functions (the editor's own case: a slider moves
+/// through new values).
+fn distinct_values(lo: f64, hi: f64, clients: usize, changes: usize) -> Vec<Vec<f64>> {
+    let phi = 0.618_033_988_749_894_9;
+    (0..clients)
+        .map(|c| (0..changes).map(|k| lo + (hi - lo) * (((c * changes + k + 1) as f64) * phi).fract()).collect())
+        .collect()
+}
+
+/// `values.len()` threads each send their values of `param`, one request at a time, and
+/// check every answer against `expected` (the library's hash for the value, computed before
+/// the clock starts, so that the checking does not load the machine during the run);
+/// returns the latencies (ms).
+fn load(url: &str, text: &str, param: &str, values: &[Vec<f64>], expected: &HashMap<u64, String>) -> Vec<f64> {
     std::thread::scope(|s| {
-        let handles: Vec<_> = (0..clients)
-            .map(|c| {
+        let handles: Vec<_> = values
+            .iter()
+            .enumerate()
+            .map(|(c, vs)| {
                 s.spawn(move || {
                     let agent = ureq::Agent::new_with_defaults();
                     let mut lat = Vec::new();
-                    for k in 0..changes {
-                        let v = values[(c * 7 + k) % values.len()];
+                    for (k, &v) in vs.iter().enumerate() {
                         let body = json!({"text": text, "name": "load", "params": {param: v}});
                         let t = Instant::now();
                         let mut r = agent
@@ -47,7 +62,7 @@ fn load(url: &str, text: &str, param: &str, values: &[f64], clients: usize, chan
                         let h = header(&bytes);
                         let got = h["params"].as_array().unwrap().iter().find(|p| p["name"] == param).unwrap();
                         assert_eq!(got["value"].as_f64().unwrap(), v);
-                        assert_eq!(h["hash"].as_str().unwrap(), expected(text, param, v), "client {c}, change {k}");
+                        assert_eq!(h["hash"].as_str().unwrap(), expected[&v.to_bits()], "client {c}, change {k}");
                     }
                     lat
                 })
@@ -57,20 +72,16 @@ fn load(url: &str, text: &str, param: &str, values: &[f64], clients: usize, chan
     })
 }
 
-fn expected(text: &str, param: &str, v: f64) -> String {
-    use std::sync::{Mutex, OnceLock};
-    // keyed by the scene text too: the tests of this file run in parallel on different scenes
-    type Key = (String, String, u64);
-    static CACHE: OnceLock<Mutex<HashMap<Key, String>>> = OnceLock::new();
-    let key = (text.to_string(), param.to_string(), v.to_bits());
-    let cache = CACHE.get_or_init(Default::default);
-    if let Some(h) = cache.lock().unwrap().get(&key) {
-        return h.clone();
-    }
-    let opts = LoadOptions { params: HashMap::from([(param.to_string(), v)]), ..Default::default() };
-    let h = hash(&Scene::parse_with(text, "load.toml", "load", &opts).unwrap());
-    cache.lock().unwrap().insert(key, h.clone());
-    h
+/// The library's mesh hash for every value (in parallel, before any request is sent).
+fn expected(text: &str, param: &str, values: &[Vec<f64>]) -> HashMap<u64, String> {
+    use rayon::prelude::*;
+    let all: Vec<f64> = values.iter().flatten().copied().collect();
+    all.par_iter()
+        .map(|&v| {
+            let opts = LoadOptions { params: HashMap::from([(param.to_string(), v)]), ..Default::default() };
+            (v.to_bits(), hash(&Scene::parse_with(text, "load.toml", "load", &opts).unwrap()))
+        })
+        .collect()
 }
 
 fn percentile(v: &mut [f64], q: f64) -> f64 {
@@ -82,21 +93,22 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
 fn eight_clients_get_correct_meshes() {
     let (_server, url) = common::serve(None);
     let text = example("four-curve-patch.toml");
-    let values: Vec<f64> = (0..10).map(|i| 0.8 + 0.1 * i as f64).collect();
-    let lat = load(&url, &text, "a", &values, 8, 25);
+    let values = distinct_values(0.8, 1.7, 8, 25);
+    let lat = load(&url, &text, "a", &values, &expected(&text, "a", &values));
     assert_eq!(lat.len(), 200);
 }
 
 /// The Klein bottle (order 40) under load in reduced form, cheap enough for every run
-/// since its modes solve in f64: 4 clients × 25 changes of `a` at 100 × 100, every answer
+/// since its modes solve in f64: 4 clients × 25 changes of `a` at 100 × 100 (every value
+/// new), every answer
 /// bit-identical to the library's meshes; the median and p99 latency are printed (not
 /// asserted: timing belongs to benchmarks).
 #[test]
 fn klein_bottle_under_load_reduced() {
     let (_server, url) = common::serve(None);
     let text = example("klein-bottle.toml").replace("resolution = [161, 65]", "resolution = [100, 100]");
-    let values: Vec<f64> = (0..16).map(|i| 0.8 + 0.05 * i as f64).collect();
-    let mut lat = load(&url, &text, "a", &values, 4, 25);
+    let values = distinct_values(0.8, 1.6, 4, 25);
+    let mut lat = load(&url, &text, "a", &values, &expected(&text, "a", &values));
     assert_eq!(lat.len(), 100);
     let (p50, p99) = (percentile(&mut lat, 0.5), percentile(&mut lat, 0.99));
     println!("klein 100x100, 4 clients x 25 changes: median {p50:.1} ms, p99 {p99:.1} ms");
@@ -110,9 +122,10 @@ fn klein_bottle_under_load_reduced() {
 fn klein_bottle_load_latency() {
     let (_server, url) = common::serve(None);
     let text = example("klein-bottle.toml").replace("resolution = [161, 65]", "resolution = [100, 100]");
-    let values: Vec<f64> = (0..16).map(|i| 0.8 + 0.05 * i as f64).collect();
+    let values = distinct_values(0.8, 1.6, 8, 200);
+    let expected = expected(&text, "a", &values);
     let t = Instant::now();
-    let mut lat = load(&url, &text, "a", &values, 8, 200);
+    let mut lat = load(&url, &text, "a", &values, &expected);
     let wall = t.elapsed().as_secs_f64();
     let (p50, p99) = (percentile(&mut lat, 0.5), percentile(&mut lat, 0.99));
     println!("klein 100x100: {} requests in {wall:.1} s, median {p50:.1} ms, p99 {p99:.1} ms", lat.len());

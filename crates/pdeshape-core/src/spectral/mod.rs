@@ -142,15 +142,17 @@ fn describe(conds: &[CondSpec]) -> String {
     conds.iter().map(|c| format!("∂^{} at u = {}", c.order, c.u)).collect::<Vec<_>>().join(", ")
 }
 
+/// `(rate bits, n, condition positions and orders, kmax)`.
+type MemoKey = (u64, usize, Vec<(u64, usize)>, usize);
+static CARDINAL_MEMO: std::sync::OnceLock<Mutex<HashMap<MemoKey, Arc<CardinalSet>>>> = std::sync::OnceLock::new();
+
 /// Cardinal functions of `ExpSpace::symmetric(rate, n)` for the condition set, memoised
 /// process-wide: they depend only on the operator and the condition positions, not on the
 /// data, so re-solving with new boundary curves (a designer dragging a curve or a section
 /// parameter) reuses them. Bounded: the memo is emptied when it holds 256 sets.
 fn cardinal_set(rate: f64, n: usize, specs: &[CondSpec], kmax: usize) -> Result<Arc<CardinalSet>, OdeError> {
-    type Key = (u64, usize, Vec<(u64, usize)>, usize);
-    static MEMO: std::sync::OnceLock<Mutex<HashMap<Key, Arc<CardinalSet>>>> = std::sync::OnceLock::new();
-    let key: Key = (rate.to_bits(), n, specs.iter().map(|c| (c.u.to_bits(), c.order)).collect(), kmax);
-    let memo = MEMO.get_or_init(Default::default);
+    let key: MemoKey = (rate.to_bits(), n, specs.iter().map(|c| (c.u.to_bits(), c.order)).collect(), kmax);
+    let memo = CARDINAL_MEMO.get_or_init(Default::default);
     if let Some(c) = memo.lock().ok().and_then(|m| m.get(&key).cloned()) {
         return Ok(c);
     }
@@ -162,6 +164,12 @@ fn cardinal_set(rate: f64, n: usize, specs: &[CondSpec], kmax: usize) -> Result<
         m.insert(key, c.clone());
     }
     Ok(c)
+}
+
+/// Empties the process-wide memo of cardinal functions, so that the next solves compute
+/// them anew (benchmarks of cold solves use it; results do not change).
+pub fn clear_cardinal_memo() {
+    CARDINAL_MEMO.get_or_init(Default::default).lock().map(|mut m| m.clear()).unwrap_or(())
 }
 
 impl SpectralPatch {
