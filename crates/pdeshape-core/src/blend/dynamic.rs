@@ -10,8 +10,10 @@ use crate::num::MaxNan;
 use crate::ode::{Cardinal, CondSpec, ExpSpace};
 use crate::patch::{Condition, Surface, VDomain, cubic_hermite};
 use faer::Mat;
+use std::collections::HashMap;
 use std::f64::consts::PI;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// `β∂u⁴ + γ∂u²∂v² + λ∂v⁴ + ρ∂t² + η∂t`: the dynamic blend operator with its five shape
 /// parameters (paper 002 eq. 3, without the force term).
@@ -282,6 +284,12 @@ pub struct DynamicBlend {
     eigen: Vec<Option<(f64, f64)>>,
     exact: Option<Vec<Arc<Cardinal>>>,
     opts: DynamicOptions,
+    /// Frames solved so far, by the bits of `t`: every caller (mesh, animation, reports,
+    /// exporters) asks [`frame`](Self::frame) and each instant is solved once. Shared by
+    /// clones, which are the same blend.
+    frames: Arc<Mutex<HashMap<u64, DynamicFrame>>>,
+    /// How many frames were solved (not served from `frames`).
+    solves: Arc<AtomicUsize>,
 }
 
 /// What a frame's solve did.
@@ -444,7 +452,17 @@ impl DynamicBlend {
         } else {
             None
         };
-        Ok(DynamicBlend { op, domain, basis, coef, eigen, exact, opts: opts.clone() })
+        Ok(DynamicBlend {
+            op,
+            domain,
+            basis,
+            coef,
+            eigen,
+            exact,
+            opts: opts.clone(),
+            frames: Default::default(),
+            solves: Default::default(),
+        })
     }
 
     /// The basis functions.
@@ -457,10 +475,33 @@ impl DynamicBlend {
         self.op
     }
 
-    #[allow(clippy::needless_range_loop)] // (l, m) index the grid row l·M + m and the tables
     /// The frame at time `t` (solves the collocation problem at `t` when the collocation
-    /// solver is in use).
+    /// solver is in use), solved once per instant: later calls for the same `t` return
+    /// the frame already solved.
     pub fn frame(&self, t: f64) -> Result<DynamicFrame, BlendError> {
+        if let Some(f) = self.frames.lock().ok().and_then(|m| m.get(&t.to_bits()).cloned()) {
+            return Ok(f);
+        }
+        let f = self.solve_frame(t)?;
+        self.solves.fetch_add(1, Ordering::Relaxed);
+        if let Ok(mut m) = self.frames.lock() {
+            // bounded: a long animation or a scan of t does not grow it without end
+            if m.len() >= 1024 {
+                m.clear();
+            }
+            m.insert(t.to_bits(), f.clone());
+        }
+        Ok(f)
+    }
+
+    /// How many frames this blend (and its clones) has solved; instants asked for again
+    /// are served from the frames already solved.
+    pub fn frames_solved(&self) -> usize {
+        self.solves.load(Ordering::Relaxed)
+    }
+
+    #[allow(clippy::needless_range_loop)] // (l, m) index the grid row l·M + m and the tables
+    fn solve_frame(&self, t: f64) -> Result<DynamicFrame, BlendError> {
         let nj = self.basis.len();
         let w = |j: usize| -> [Vec3; 4] { std::array::from_fn(|c| self.coef[c][j]) };
         if let Some(cards) = &self.exact {
