@@ -48,7 +48,7 @@ fn build_one(name: &str, text: &str, dir: &Path, limits: pdeshape_core::limits::
     e.description = scene.description.clone().unwrap_or_default();
     e.reference = scene.reference.clone().unwrap_or_default();
     let sub = dir.join(name);
-    match crate::cli::build_into_dir(&scene, &sub) {
+    match crate::build::build_into_dir(&scene, &sub) {
         Ok(files) => {
             for f in files {
                 let rel =

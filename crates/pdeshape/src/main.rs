@@ -2,6 +2,7 @@
 //! `pdeshape-io` (scene files, exporters, pictures).
 
 mod bench;
+mod build;
 mod cli;
 mod gallery;
 mod serve;
