@@ -8,7 +8,7 @@
 //! parameter by a hair, so the cardinal functions (memoised across solves by their rates)
 //! are computed anew every time.
 //!
-//! Run: cargo bench -p pdeshape-io --bench surfaces
+//! Run: cargo bench -p pdeshape-bench --bench surfaces
 use criterion::{Criterion, criterion_group, criterion_main};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};

@@ -1,10 +1,10 @@
 //! Stage timings of the eq. 19 dynamic blend (medians of 51 runs, one thread).
-//! Run: cargo run --release -p pdeshape-io --example dynamic_timing
+//! Run: cargo run --release -p pdeshape-bench --example dynamic_timing
+use pdeshape_bench::tables::{on_one_thread, time};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_core::patch::Surface;
 use pdeshape_io::scene::Scene;
-use pdeshape_io::tables::{on_one_thread, time};
 
 /// The allocator of the `pdeshape` binary, so that timings match it.
 #[global_allocator]

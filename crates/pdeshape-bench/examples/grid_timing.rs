@@ -1,5 +1,5 @@
 //! Stage timings of the 100 × 100 surface evaluation (medians of 200 runs).
-//! Run: cargo run --release -p pdeshape-io --example grid_timing
+//! Run: cargo run --release -p pdeshape-bench --example grid_timing
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_io::scene::Scene;
 use std::time::Instant;

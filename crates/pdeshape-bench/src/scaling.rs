@@ -5,11 +5,11 @@
 //! Solve timings are cold: every run uses a slightly different shape parameter `a`
 //! (`1 + k·10⁻⁹`), so the process-wide memo of cardinal functions cannot serve it.
 
-use crate::render::Image;
-use crate::render::{Series, line_plot};
-use crate::scene::{LoadOptions, Scene};
 use crate::tables::{Timing, time};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
+use pdeshape_io::render::Image;
+use pdeshape_io::render::{Series, line_plot};
+use pdeshape_io::scene::{LoadOptions, Scene};
 use serde::Serialize;
 use std::collections::HashMap;
 

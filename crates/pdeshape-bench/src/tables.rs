@@ -4,10 +4,10 @@
 //! compare with SPEC §10's one-core targets; deviations are max distances over a 100 × 100
 //! grid of `(u, v)`.
 
-use crate::scene::{DynamicSetup, Scene, ScenePatch};
 use pdeshape_core::blend::{DynamicBlend, DynamicOptions, Solver};
 use pdeshape_core::mesh::{GridOptions, grid_mesh};
 use pdeshape_core::patch::Surface;
+use pdeshape_io::scene::{DynamicSetup, Scene, ScenePatch};
 use serde::Serialize;
 use std::time::Instant;
 

@@ -10,6 +10,4 @@ pub mod export;
 pub mod model;
 pub mod render;
 pub mod sample;
-pub mod scaling;
 pub mod scene;
-pub mod tables;

@@ -1,7 +1,7 @@
 """Overhead of the Python layer: 10⁶ exact Bloor–Wilson blend points through `Patch.evaluate`.
 
 Compare with the Rust side, the same call on the same points:
-    cargo bench -p pdeshape-io --bench surfaces -- "evaluate/bloor-wilson"
+    cargo bench -p pdeshape-bench --bench surfaces -- "evaluate/bloor-wilson"
 Run both on one thread (the bench pins one; here):
     RAYON_NUM_THREADS=1 python crates/pdeshape-py/bench/evaluate.py
 Prints the median of 10 runs (the array conversion included).

@@ -2,9 +2,9 @@
 
 use crate::EXAMPLES;
 use anyhow::{Result, anyhow};
+use pdeshape_bench::tables::{self, AccuracyRow, Table1Row, TrimTableRow};
 use pdeshape_core::limits::Limits;
 use pdeshape_io::scene::Scene;
-use pdeshape_io::tables::{self, AccuracyRow, Table1Row, TrimTableRow};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -53,7 +53,7 @@ pub fn run(runs: usize, json_out: bool, out: Option<&Path>, limits: Limits) -> R
 
 /// The scaling study: `scaling.md`, `scaling.json` and four plots in `dir`.
 pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool, limits: Limits) -> Result<()> {
-    use pdeshape_io::scaling;
+    use pdeshape_bench::scaling;
     let text = |name: &str| {
         EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))
     };
