@@ -31,6 +31,7 @@
 mod curve;
 mod grid;
 mod laplace;
+mod metric;
 mod on_surface;
 mod param;
 mod region;
@@ -40,6 +41,7 @@ mod tests;
 pub use curve::{TrimCurve, Uv, distance_to_polygon, inside_polygon, signed_area2};
 pub use grid::{TrimGrid, TrimOptions, TrimReport, count_folds, is_folded, reflex_corner, trim_grid, trimmed_mesh};
 pub use laplace::{FFT_SAMPLES, LaplaceMap};
+pub use metric::{MetricTrim, metric_scale, trim_in_metric};
 pub use on_surface::CurveOnSurface;
 pub use param::{ARC_WEIGHT, ARC_WEIGHT_BRIDGED};
 pub use region::{Piece, Rect, TrimRegion};

@@ -997,7 +997,7 @@ fn build_patch(
         PatchKind::Fill => unreachable!("fills are built by fill::build_fill"),
     };
     let color = rp.color.as_ref().map(|c| *c.get_ref());
-    let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, domain, surface.as_ref())).transpose()?;
+    let trim = rp.trim.as_ref().map(|t| super::trim::build_trim(ctx, &key, t, surface.as_ref())).transpose()?;
     Ok(ScenePatch {
         name: pname.to_string(),
         kind,

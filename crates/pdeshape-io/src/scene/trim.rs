@@ -5,8 +5,8 @@ use super::build::{Ctx, R, span};
 use super::raw::{NumOrExpr, RawTrim, RawTrimCurve};
 use super::{ScenePatch, TrimSetup};
 use pdeshape_core::data::FieldRef;
-use pdeshape_core::patch::{Surface, VDomain};
-use pdeshape_core::trim::{CurveOnSurface, LaplaceMap, Rect, TrimCurve, TrimOptions, TrimRegion, trim_grid};
+use pdeshape_core::patch::Surface;
+use pdeshape_core::trim::{CurveOnSurface, TrimCurve, TrimOptions, trim_in_metric};
 use std::sync::Arc;
 use toml::Spanned;
 
@@ -50,13 +50,7 @@ fn curve(ctx: &Ctx, rc: &Spanned<RawTrimCurve>, key: &str) -> R<TrimCurve> {
 
 /// The trim of a patch: curves validated against the patch's domain, the Laplace map and
 /// the repaired grid.
-pub(super) fn build_trim(
-    ctx: &Ctx,
-    key: &str,
-    raw: &Spanned<RawTrim>,
-    domain: VDomain,
-    surface: &dyn Surface,
-) -> R<TrimSetup> {
+pub(super) fn build_trim(ctx: &Ctx, key: &str, raw: &Spanned<RawTrim>, surface: &dyn Surface) -> R<TrimSetup> {
     let key = format!("{key}.trim");
     let rt = raw.get_ref();
     let (rings, columns) = ctx.resolution(&rt.resolution, (20, 64), &format!("{key}.resolution"))?;
@@ -78,53 +72,10 @@ pub(super) fn build_trim(
     for (name, rc) in &rt.curves {
         curves.push((name.clone(), curve(ctx, rc, &format!("{key}.curves.{name}"))?));
     }
-    let rect = Rect { min: [0.0, domain.start], max: [1.0, domain.end] };
-    // validate in the patch's own parameters (errors quote its u, v)
-    TrimRegion::new(rect, curves.clone()).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-    // mesh in the metric-scaled plane (u, k v), k = mean|X_v| / mean|X_u|; the scaling is a
-    // heuristic, so where its map keeps folds after repair, the geometric mean of k and 1
-    // and then the plain parameter plane are tried before the first failure is reported
-    let k = metric_scale(surface);
-    let mut first_error = None;
-    for ks in [k, k.sqrt(), 1.0] {
-        let scale = [1.0, ks];
-        let scaled_rect = Rect { min: [0.0, domain.start * scale[1]], max: [1.0, domain.end * scale[1]] };
-        let scaled: Vec<_> = curves.iter().map(|(n, c)| (n.clone(), c.scaled(scale))).collect();
-        let region = TrimRegion::new(scaled_rect, scaled).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
-        let map = LaplaceMap::new(region, modes, Some(columns));
-        match trim_grid(&map, &TrimOptions { rings, columns, modes, ..Default::default() }) {
-            Ok(mut grid) => {
-                for p in &mut grid.points {
-                    p[1] /= scale[1];
-                }
-                return Ok(TrimSetup { map: Arc::new(map), grid: Arc::new(grid), curves, scale });
-            }
-            Err(e) => {
-                first_error.get_or_insert(e);
-                if k == 1.0 {
-                    break;
-                }
-            }
-        }
-    }
-    let e = first_error.expect("at least one attempt");
-    Err(ctx.err(span(raw), &key, e.to_string()))
-}
-
-/// `mean |X_v| / mean |X_u|` over a 9 × 9 grid: the factor on `v` that makes the
-/// parameter plane roughly isometric to the patch, so the Laplace map and its repair work
-/// on the shape the designer sees (a long body with small fin holes stays meshable).
-fn metric_scale(s: &dyn Surface) -> f64 {
-    let dom = s.v_domain();
-    let (mut su, mut sv) = (0.0, 0.0);
-    for i in 0..9 {
-        for j in 0..9 {
-            let d = s.derivatives((i as f64 + 0.5) / 9.0, dom.at((j as f64 + 0.5) / 9.0), 1, 1);
-            su += d[2].norm();
-            sv += d[1].norm();
-        }
-    }
-    if su > 0.0 && sv > 0.0 && (sv / su).is_finite() { sv / su } else { 1.0 }
+    // validated in the patch's own parameters, meshed in the metric-scaled plane
+    let o = TrimOptions { rings, columns, modes, ..Default::default() };
+    let t = trim_in_metric(surface, &curves, &o).map_err(|e| ctx.err(span(raw), &key, e.to_string()))?;
+    Ok(TrimSetup { map: Arc::new(t.map), grid: Arc::new(t.grid), curves, scale: t.scale })
 }
 
 /// The curve `X_P(C(t))` for `trim = "P.C"`: trim curve `C` of the earlier patch `P`.
