@@ -3,7 +3,8 @@
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
 use pdeshape_core::blend::{
-    DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, attached_gaps_at, attached_seam_gaps, gaps_at, seam_gaps,
+    ContinuityClass, DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, attached_gaps_at, attached_seam_gaps, gaps_at,
+    seam_gaps,
 };
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
@@ -1016,32 +1017,6 @@ pub fn blend_condition_report(b: &StaticBlend, conds: &[Condition]) -> pdeshape_
     rep
 }
 
-/// Thresholds of the continuity classification, relative to the patch size (C0, C1, C2)
-/// and absolute (G1 in radians, G2 in curvature × size).
-pub const CONTINUITY_TOL: f64 = 1e-8;
-
-/// The highest continuity met at both ends: `"none"`, `"C0"`, `"G1"`, `"C1"`, `"G2"`,
-/// `"C2"` (C2 includes G2; G2 is reported when curvature matches without C2).
-pub fn continuity_class(ends: &[Gaps], size: f64) -> &'static str {
-    let ok = |f: fn(&Gaps) -> Option<f64>, tol: f64| ends.iter().all(|g| f(g).is_some_and(|x| x <= tol));
-    let tol = CONTINUITY_TOL * size.max(1e-300);
-    if !ok(|g| g.c0, tol) {
-        return "none";
-    }
-    if !ok(|g| g.g1, CONTINUITY_TOL) {
-        return "C0";
-    }
-    let c1 = ok(|g| g.c1, tol);
-    let g2 = ok(|g| g.g2, CONTINUITY_TOL / size.max(1e-300));
-    if c1 && ok(|g| g.c2, tol) {
-        return "C2";
-    }
-    if g2 {
-        return "G2";
-    }
-    if c1 { "C1" } else { "G1" }
-}
-
 /// Inserts `key: v` when `v` was computed. A value that was not computed is left out
 /// rather than written as `null`: `null` in a report means a NaN or an infinity (serde_json
 /// writes them so), which the tests refuse.
@@ -1080,7 +1055,7 @@ fn attached_diagnostics(p: &ScenePatch, d: &mut Value, size: f64) {
     let ends = attached_ends(p);
     let seams: Vec<SeamGaps> = ends.iter().map(|(u, data)| attached_seam_gaps(s, *u, data, 400)).collect();
     let mut c = json!({
-        "class": continuity_class(&seams.iter().map(|g| g.max).collect::<Vec<_>>(), size),
+        "class": ContinuityClass::of(&seams.iter().map(|g| g.max).collect::<Vec<_>>(), size).name(),
         "samples": 400,
         "with": if p.fill.is_some() { "neighbouring surface" } else { "trim curve" },
     });
@@ -1187,7 +1162,7 @@ fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut V
     d["continuity"] = json!({
         "start": gaps_json(&ends[0]),
         "end": gaps_json(&ends[1]),
-        "class": continuity_class(&ends, size),
+        "class": ContinuityClass::of(&ends, size).name(),
         "samples": 400,
         "worst": worst_json(b, &seams),
     });

@@ -23,6 +23,65 @@ pub struct Gaps {
     pub g2: Option<f64>,
 }
 
+/// Thresholds of the continuity classification: relative to the patch size for C0, C1 and
+/// C2, absolute for G1 (radians), and over the size for G2 (a curvature).
+pub const CONTINUITY_TOL: f64 = 1e-8;
+
+/// The highest continuity a seam meets at every point (see [`ContinuityClass::of`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContinuityClass {
+    /// Positions differ.
+    None,
+    /// Positions agree, normals do not.
+    C0,
+    /// Normals agree (G1), cross derivatives do not, curvature not matched.
+    G1,
+    /// Cross derivatives agree (C1), curvature not matched.
+    C1,
+    /// Normal curvature across the seam agrees (G2), second derivatives do not.
+    G2,
+    /// Second cross derivatives agree too (C2, which includes G2).
+    C2,
+}
+
+impl ContinuityClass {
+    /// The class met at every one of `ends` (worst gaps per seam) for a patch of size
+    /// `size`: C0 at `CONTINUITY_TOL · size`, then G1 at `CONTINUITY_TOL` radians, C1 and
+    /// C2 at `CONTINUITY_TOL · size`, G2 at `CONTINUITY_TOL / size`. A gap that was not
+    /// computed, or is NaN, is not met.
+    pub fn of(ends: &[Gaps], size: f64) -> Self {
+        let ok = |f: fn(&Gaps) -> Option<f64>, tol: f64| ends.iter().all(|g| f(g).is_some_and(|x| x <= tol));
+        let size = if size > 1e-300 { size } else { 1e-300 };
+        let tol = CONTINUITY_TOL * size;
+        if !ok(|g| g.c0, tol) {
+            return ContinuityClass::None;
+        }
+        if !ok(|g| g.g1, CONTINUITY_TOL) {
+            return ContinuityClass::C0;
+        }
+        let c1 = ok(|g| g.c1, tol);
+        if c1 && ok(|g| g.c2, tol) {
+            return ContinuityClass::C2;
+        }
+        if ok(|g| g.g2, CONTINUITY_TOL / size) {
+            return ContinuityClass::G2;
+        }
+        if c1 { ContinuityClass::C1 } else { ContinuityClass::G1 }
+    }
+
+    /// `"none"`, `"C0"`, `"G1"`, `"C1"`, `"G2"` or `"C2"` (the reports' spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            ContinuityClass::None => "none",
+            ContinuityClass::C0 => "C0",
+            ContinuityClass::G1 => "G1",
+            ContinuityClass::C1 => "C1",
+            ContinuityClass::G2 => "G2",
+            ContinuityClass::C2 => "C2",
+        }
+    }
+}
+
 impl Gaps {
     /// Entry-wise maximum (NaN when either is NaN).
     pub fn max(self, o: Gaps) -> Gaps {
@@ -156,6 +215,28 @@ fn seam_with(x: &dyn Surface, samples: usize, gaps: impl Fn(f64) -> Gaps) -> Sea
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn continuity_classes_from_hand_made_gaps() {
+        let g = |c0, c1, g1, c2, g2| Gaps { c0, c1, g1, c2, g2 };
+        let z = Some(0.0);
+        let big = Some(1e-3);
+        let class = |gs: &[Gaps]| ContinuityClass::of(gs, 2.0);
+        assert_eq!(class(&[g(z, z, z, z, z)]), ContinuityClass::C2);
+        assert_eq!(class(&[g(z, z, z, big, z)]), ContinuityClass::G2);
+        assert_eq!(class(&[g(z, z, z, big, big)]), ContinuityClass::C1);
+        assert_eq!(class(&[g(z, big, z, None, None)]), ContinuityClass::G1);
+        assert_eq!(class(&[g(z, z, big, z, z)]), ContinuityClass::C0);
+        assert_eq!(class(&[g(big, z, z, z, z)]), ContinuityClass::None);
+        // not computed, or NaN, is not met; the worst end decides
+        assert_eq!(class(&[g(None, z, z, z, z)]), ContinuityClass::None);
+        assert_eq!(class(&[g(Some(f64::NAN), z, z, z, z)]), ContinuityClass::None);
+        assert_eq!(class(&[g(z, z, z, z, z), g(z, z, Some(f64::NAN), z, z)]), ContinuityClass::C0);
+        // C0, C1, C2 scale with the size (1e-8 × 2 here), G1 does not
+        assert_eq!(class(&[g(Some(1.5e-8), z, z, z, z)]), ContinuityClass::C2);
+        assert_eq!(class(&[g(Some(2.5e-8), z, z, z, z)]), ContinuityClass::None);
+        assert_eq!(ContinuityClass::G2.name(), "G2");
+    }
     use crate::data::{ExprField, Trimline};
     use crate::patch::VDomain;
     use std::sync::Arc;

@@ -24,7 +24,10 @@ mod solve;
 
 pub use basis::{BasisFn, Decomposition, MAX_SPLIT_MODES, decompose};
 pub use bubble::bubbles;
-pub use continuity::{Gaps, SeamGaps, attached_gaps_at, attached_seam_gaps, continuity, gaps_at, seam_gaps};
+pub use continuity::{
+    CONTINUITY_TOL, ContinuityClass, Gaps, SeamGaps, attached_gaps_at, attached_seam_gaps, continuity, gaps_at,
+    seam_gaps,
+};
 pub use dynamic::{DynBasis, DynamicBlend, DynamicFrame, DynamicOperator, DynamicOptions, DynamicReport, zeta};
 pub use operator::Operator;
 pub use solve::{BlendOptions, ComponentReport, Solver, StaticBlend};
