@@ -641,9 +641,7 @@ fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
     // interior points (boundary surfaces may have singular derivatives on the edges)
     let mut r2 = 0.0;
     let n = 512;
-    for i in 0..n {
-        let at = |a: f64, b: f64| 0.02 + 0.96 * (i as f64 * a + b).fract();
-        let (u, v, w) = (at(0.618034, 0.1), at(0.414214, 0.2), at(0.732051, 0.3));
+    for [u, v, w] in pdeshape_core::solid::interior_points(n) {
         r2 += s.residual(u, v, w).norm().powi(2);
     }
     let rep = s.report();
@@ -1282,18 +1280,11 @@ pub fn blend_convergence_plot(scene: &Scene) -> Option<Result<Image, String>> {
 pub fn solid_convergence_plot(p: &ScenePatch) -> Option<Result<Image, String>> {
     use pdeshape_core::solid::{SolidBlend, SolidOptions};
     let sd = p.solid.as_ref()?;
-    let base = sd.blend.report();
-    let trial = match base.method {
-        "galerkin" => pdeshape_core::solid::Trial::Galerkin,
-        "collocation" => pdeshape_core::solid::Trial::Collocation,
-        _ => pdeshape_core::solid::Trial::Complete,
-    };
-    let pts: Vec<(f64, f64, f64)> = (0..300)
-        .map(|i| {
-            let at = |a: f64, b: f64| 0.02 + 0.96 * (i as f64 * a + b).fract();
-            (at(0.618034, 0.1), at(0.414214, 0.2), at(0.732051, 0.3))
-        })
-        .collect();
+    // the trial space it was solved with (the report's method name used to be parsed
+    // back, which sent the paper's trial space to the complete one)
+    let trial = sd.blend.options().trial;
+    let pts: Vec<(f64, f64, f64)> =
+        pdeshape_core::solid::interior_points(300).into_iter().map(|[u, v, w]| (u, v, w)).collect();
     let (mut change, mut rms) = (Vec::new(), Vec::new());
     let mut prev: Option<Vec<pdeshape_core::Vec3>> = None;
     let top = if trial == pdeshape_core::solid::Trial::Collocation { 8 } else { 12 };

@@ -169,6 +169,11 @@ impl SolidBlend {
         self.op
     }
 
+    /// The options it was solved with (trial space and term counts).
+    pub fn options(&self) -> SolidOptions {
+        self.opts
+    }
+
     /// What the solve did.
     pub fn report(&self) -> &SolidReport {
         &self.report

@@ -23,12 +23,14 @@ mod boundary;
 mod face;
 mod gauss;
 mod mass;
+mod sample;
 
 pub use blend::{SolidBlend, SolidOperator, SolidOptions, SolidReport, Trial};
 pub use boundary::{boundary_mesh, boundary_mesh_of, cross_section, hex_mesh};
 pub use face::{SolidFace, boundary_faces};
 pub use gauss::gauss_legendre;
 pub use mass::MassProperties;
+pub use sample::interior_points;
 
 /// Why a solid blend cannot be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
