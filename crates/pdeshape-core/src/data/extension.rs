@@ -1,7 +1,8 @@
 //! Even extension of boundary data on an open interval to a periodic function (SPEC §2).
 
 use super::{Field, FieldRef, VecJet};
-use crate::jet::{Jet, JetShape};
+use crate::Vec3;
+use crate::jet::{Jet, JetShape, MAX_VARS};
 use std::f64::consts::PI;
 
 /// The even, 2π-periodic extension `g̃(θ)` of a function `g(v)` on `[v₀, v₁]`:
@@ -45,6 +46,22 @@ impl Field for EvenExtension {
                 shape.multi_indices().zip(j.0[k].coeffs()).map(|(m, c)| c * dv.powi(m[0] as i32)).collect();
             Jet::from_coeffs(shape, c)
         }))
+    }
+    /// The inner field's one-slot derivatives at the mapped point, times `(dv/dθ)ᵏ` in slot 0.
+    fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        let (v, dv) = self.map(at[0]);
+        let mut a = [0.0; MAX_VARS];
+        let n = at.len().min(MAX_VARS);
+        a[..n].copy_from_slice(&at[..n]);
+        a[0] = v;
+        self.inner.derivatives_in(&a[..n], slot, out);
+        if slot == 0 {
+            let mut f = 1.0;
+            for o in out.iter_mut() {
+                *o *= f;
+                f *= dv;
+            }
+        }
     }
     fn is_constant_in(&self, slot: usize) -> bool {
         self.inner.is_constant_in(slot)
