@@ -4,9 +4,11 @@
 //! example 2 (solve at L = M = N = 6, evaluation at 64³).
 //!
 //! One thread (the global rayon pool is built with one worker: the SPEC targets are for one
-//! core; `PDESHAPE_BENCH_THREADS=2` for the two-thread tables), and nothing memoised between iterations of a solve: each iteration changes a
-//! parameter by a hair, so the cardinal functions (memoised across solves by their rates)
-//! are computed anew every time.
+//! core; `PDESHAPE_BENCH_THREADS=2` for the two-thread tables), and nothing memoised
+//! between iterations of a solve: each iteration changes a parameter by a hair (the dolphin
+//! empties the memo), so the cardinal functions (memoised across solves by their rates) are
+//! computed anew every time. Also issue 16's targets (four-curve M = 6 and M = 256, the
+//! dolphin's cold build) and issue 21's fills.
 //!
 //! Run: cargo bench -p pdeshape-bench --bench surfaces
 use criterion::{Criterion, criterion_group, criterion_main};
