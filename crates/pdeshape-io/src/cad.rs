@@ -407,6 +407,115 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
     out
 }
 
+/// The seams `check` and `build` report: [`seams`] at 200 points, without a solid's edges
+/// (its faces meet at an angle by construction) and without those between alternative
+/// patches that join the same surfaces (both patches, the same boundary).
+pub fn reported_seams(fitted: &[CadFace]) -> Vec<Seam> {
+    seams(fitted, 200)
+        .into_iter()
+        .filter(|s| {
+            let [(a, ua), (b, ub)] = s.faces;
+            let solid = fitted[a].outward.is_some() && fitted[b].outward.is_some();
+            !solid && (fitted[a].primary || fitted[b].primary || ua != ub)
+        })
+        .collect()
+}
+
+/// The CAD fit of a scene as `check --json --cad` reports it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CadReport {
+    /// The fitted faces.
+    pub faces: Vec<CadFaceReport>,
+    /// The seams between them ([`reported_seams`]).
+    pub seams: Vec<CadSeamReport>,
+}
+
+/// One fitted face.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CadFaceReport {
+    /// The patch's name, or `surface-NAME`.
+    pub name: String,
+    /// A primary surface's drawn part.
+    pub primary: bool,
+    /// Control points `[nu, nv]`.
+    pub control_points: [usize; 2],
+    /// The tolerance the fit was certified against.
+    pub tolerance: f64,
+    /// The certified maximum deviation.
+    pub certified_deviation: f64,
+    /// The face's holes.
+    pub holes: Vec<CadHoleReport>,
+}
+
+/// One hole of a fitted face.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CadHoleReport {
+    /// The trim curve's name.
+    pub name: String,
+    /// Control points of its space curve.
+    pub control_points: usize,
+    /// Its certified deviation from the exact curve on the face.
+    pub certified_deviation: f64,
+}
+
+/// One seam between fitted faces.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CadSeamReport {
+    /// The two faces' names.
+    pub faces: [String; 2],
+    /// Their boundary `u`.
+    pub u: [f64; 2],
+    /// Largest gap.
+    pub gap: f64,
+    /// Largest normal angle (radians).
+    #[serde(rename = "normal_angle_radians")]
+    pub angle: f64,
+    /// Largest cross-curvature gap.
+    pub curvature_gap: f64,
+    /// Points compared.
+    pub samples: usize,
+}
+
+impl CadReport {
+    /// The report of fitted faces.
+    pub fn of(fitted: &[CadFace]) -> CadReport {
+        let faces = fitted
+            .iter()
+            .map(|f| CadFaceReport {
+                name: f.name.clone(),
+                primary: f.primary,
+                control_points: [f.report.points.0, f.report.points.1],
+                tolerance: f.report.tolerance,
+                certified_deviation: f.report.max_deviation,
+                holes: f
+                    .holes
+                    .iter()
+                    .map(|h| CadHoleReport {
+                        name: h.name.clone(),
+                        control_points: h.curve.control.len(),
+                        certified_deviation: h.deviation,
+                    })
+                    .collect(),
+            })
+            .collect();
+        let seams = reported_seams(fitted)
+            .iter()
+            .map(|s| {
+                let [(a, ua), (b, ub)] = s.faces;
+                CadSeamReport {
+                    faces: [fitted[a].name.clone(), fitted[b].name.clone()],
+                    u: [ua, ub],
+                    gap: s.gap,
+                    angle: s.angle,
+                    curvature_gap: s.curvature_gap,
+                    samples: s.samples,
+                }
+            })
+            .collect();
+        CadReport { faces, seams }
+    }
+}
+
 /// `faces` as the bytes of one STEP product named after the scene (the editor's download).
 pub fn step_bytes(sc: &Scene, faces: &[CadFace]) -> std::io::Result<Vec<u8>> {
     let mut out = Vec::new();

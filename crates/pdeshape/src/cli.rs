@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use pdeshape_core::limits::Limits;
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
+use pdeshape_io::model::report::{GapsReport, PatchReport, SceneReport};
 use pdeshape_io::scene::{LoadOptions, Scene};
 use std::collections::HashMap;
 use std::io::{BufRead, Write};
@@ -299,37 +300,25 @@ impl Load<'_> {
     }
 }
 
-/// The continuity line of a blend's diagnostics: the gaps at both trimlines, the class and
+/// The continuity line of a patch's report: the gaps at both trimlines, the class and
 /// where the G1 angle is worst.
-pub fn continuity_line(p: &serde_json::Value) -> Option<String> {
-    let c = &p["continuity"];
-    if !c.is_object() {
-        return None;
-    }
-    let f = |x: &serde_json::Value| x.as_f64().map(|v| format!("{v:.1e}")).unwrap_or_else(|| "-".into());
-    let end = |e: &serde_json::Value| {
-        format!(
-            "C0 {} C1 {} G1 {} rad C2 {} G2 {}",
-            f(&e["c0"]),
-            f(&e["c1"]),
-            f(&e["g1_radians"]),
-            f(&e["c2"]),
-            f(&e["g2"])
-        )
-    };
-    let mut line = format!("continuity {}:", c["class"].as_str().unwrap_or("?"));
-    if let Some(with) = c["with"].as_str() {
+pub fn continuity_line(p: &PatchReport) -> Option<String> {
+    let c = p.continuity.as_ref()?;
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.1e}")).unwrap_or_else(|| "-".into());
+    let end =
+        |e: &GapsReport| format!("C0 {} C1 {} G1 {} rad C2 {} G2 {}", f(e.c0), f(e.c1), f(e.g1), f(e.c2), f(e.g2));
+    let mut line = format!("continuity {}:", c.class);
+    if let Some(with) = c.with {
         line.push_str(&format!(" (with a {with})"));
     }
-    for (key, u) in [("start", 0), ("end", 1)] {
-        if c[key].is_object() {
-            line.push_str(&format!(" u={u} [{}] ", end(&c[key])));
+    for (e, u) in [(&c.start, 0), (&c.end, 1)] {
+        if let Some(e) = e {
+            line.push_str(&format!(" u={u} [{}] ", end(e)));
         }
     }
     let mut line = line.trim_end().to_string();
-    let w = &c["worst"]["g1_radians"];
-    if let (Some(u), Some(v)) = (w["u"].as_f64(), w["v"].as_f64()) {
-        line.push_str(&format!("; worst G1 angle {} rad at (u, v) = ({u}, {v:.4})", f(&w["value"])));
+    if let Some(w) = &c.worst.g1 {
+        line.push_str(&format!("; worst G1 angle {} rad at (u, v) = ({}, {:.4})", f(Some(w.value)), w.u, w.v));
     }
     Some(line)
 }
@@ -340,17 +329,11 @@ fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
 
 /// Refuses a scene whose own condition check is not finite (an overflowing domain, data of
 /// 1e300): its meshes would hold finite but meaningless numbers.
-fn check_finite_report(d: &serde_json::Value) -> Result<()> {
-    for p in d["patches"].as_array().into_iter().flatten() {
-        let e = &p["condition_error"];
-        // NaN and ±∞ serialize as JSON null
-        let finite =
-            e["max_abs"].as_f64().is_some_and(f64::is_finite) && e["max_rel"].as_f64().is_some_and(f64::is_finite);
-        if !finite {
-            bail!(not_finite(p["name"].as_str().unwrap_or("?")));
-        }
+fn check_finite_report(d: &SceneReport) -> Result<()> {
+    match d.first_not_finite() {
+        Some(p) => bail!(not_finite(&p.name)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 fn not_finite(patch: &str) -> String {
@@ -375,11 +358,11 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                         bail!(not_finite(&p.name));
                     }
                 }
-                serde_json::Value::Null
+                None
             } else {
                 let d = model::scene_diagnostics(&sc);
                 check_finite_report(&d)?;
-                d
+                Some(d)
             };
             let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
             if (tolerance.is_some() || relative_tolerance.is_some() || degree.is_some())
@@ -442,13 +425,13 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 }
             }
             if !quiet {
-                for d in diagnostics["patches"].as_array().into_iter().flatten() {
+                for d in diagnostics.iter().flat_map(|d| &d.patches) {
                     eprintln!(
                         "patch {}: {} ({}), max condition error {:.2e} (relative)",
-                        d["name"].as_str().unwrap_or(""),
-                        d["kind"].as_str().unwrap_or(""),
-                        d["solver"].as_str().unwrap_or(""),
-                        d["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
+                        d.name,
+                        d.kind.name(),
+                        d.solver,
+                        d.condition_error.max_rel
                     );
                     if let Some(line) = continuity_line(d) {
                         eprintln!("  {line}");
@@ -462,9 +445,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             let mut d = model::scene_diagnostics(&sc);
             let o = pdeshape_io::cad::CadOptions { degree: degree.unwrap_or(3), ..Default::default() };
             let fitted = if cad { Some(pdeshape_io::cad::fit_scene(&sc, &o).map_err(|e| anyhow!(e))?) } else { None };
-            if let Some(f) = &fitted {
-                d["cad"] = cad_report(f);
-            }
+            d.cad = fitted.as_deref().map(pdeshape_io::cad::CadReport::of);
             if json {
                 println!("{}", serde_json::to_string_pretty(&d)?);
             } else {
@@ -562,91 +543,94 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
 }
 
 /// The text report of `check`.
-fn print_check(sc: &Scene, d: &serde_json::Value) {
+fn print_check(sc: &Scene, d: &SceneReport) {
     println!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
-    for p in d["patches"].as_array().into_iter().flatten() {
+    for p in &d.patches {
         println!(
             "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
-            p["name"].as_str().unwrap_or(""),
-            p["kind"].as_str().unwrap_or(""),
-            p["solver"].as_str().unwrap_or(""),
-            p["conditions"].as_array().map(|a| a.len()).unwrap_or(0),
-            p["condition_error"]["max_abs"].as_f64().unwrap_or(f64::NAN),
-            p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN),
+            p.name,
+            p.kind.name(),
+            p.solver,
+            p.conditions.len(),
+            p.condition_error.max_abs,
+            p.condition_error.max_rel,
         );
-        let sp = &p["spectral"];
-        if sp.is_object() {
+        if let Some(sp) = &p.spectral {
             println!(
                 "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}, truncated-part residual {:.1e} (relative)",
-                sp["order"],
-                sp["modes"],
-                sp["omega"],
-                sp["max_mode_condition_number"].as_f64().unwrap_or(f64::NAN),
-                sp["modes_solved_in_f64"],
-                sp["modes_solved_in_multiprecision"],
-                sp["lebesgue_mode0"].as_f64().unwrap_or(f64::NAN),
-                sp["truncated_residual_relative"].as_f64().unwrap_or(f64::NAN),
+                sp.order,
+                sp.modes,
+                json_text(&sp.omega),
+                sp.max_mode_condition_number,
+                sp.modes_solved_in_f64,
+                sp.modes_solved_in_multiprecision,
+                sp.lebesgue_mode0,
+                sp.truncated_residual_relative,
             );
         }
         if let Some(line) = continuity_line(p) {
             println!("      {line}");
         }
-        let f = &p["fill"];
-        if f.is_object() {
+        if let Some(f) = &p.fill {
             println!(
                 "      fill (order {}): {} edges, {} points: G1 angle ≤ {:.1e} rad, gap ≤ {:.1e}, curvature gap ≤ {:.1e} (relative); folds {}; pole {}",
-                f["order"],
-                f["edges"],
-                f["edge_samples"],
-                f["g1_max_radians"].as_f64().unwrap_or(f64::NAN),
-                f["gap_max_relative"].as_f64().unwrap_or(f64::NAN),
-                f["g2_max_relative"].as_f64().unwrap_or(f64::NAN),
-                f["folds"],
-                f["pole"],
+                f.order,
+                f.edges,
+                f.edge_samples,
+                f.g1_max_radians,
+                f.gap_max_relative,
+                f.g2_max_relative,
+                f.folds,
+                json_text(&f.pole),
             );
         }
-        if let (Some(so), Some(mp)) = (p["solid"].as_object(), p["mass_properties"].as_object()) {
+        if let (Some(so), Some(mp)) = (&p.solid, &p.mass_properties) {
             println!(
                 "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",
-                so["terms"],
-                so["condition_number"].as_f64().unwrap_or(f64::NAN),
-                so["rms_residual"].as_f64().unwrap_or(f64::NAN),
-                mp["volume"].as_f64().unwrap_or(f64::NAN),
-                mp["centroid"],
-                mp["min_jacobian"].as_f64().unwrap_or(f64::NAN),
-                mp["max_jacobian"].as_f64().unwrap_or(f64::NAN),
+                json_text(&so.terms),
+                so.condition_number,
+                so.rms_residual,
+                mp.volume,
+                json_text(&mp.centroid),
+                mp.min_jacobian,
+                mp.max_jacobian,
             );
         }
-        if let Some(b) = p["blend"].as_object() {
-            for c in b["components"].as_array().into_iter().flatten() {
+        if let Some(b) = &p.blend {
+            for c in &b.components {
                 println!(
                     "      {}: order {}, solver {}, {} basis functions, condition {:.2e}{}",
-                    c["component"].as_str().unwrap_or(""),
-                    c["order"],
-                    c["solver"].as_str().unwrap_or(""),
-                    c["basis"].as_array().map(|a| a.len()).unwrap_or(0),
-                    c["condition_number"].as_f64().unwrap_or(f64::NAN),
-                    c["collocation_rms_residual"]
-                        .as_f64()
+                    c.component,
+                    c.order,
+                    c.solver,
+                    c.basis.len(),
+                    c.condition_number,
+                    c.collocation_rms_residual
                         .map(|r| format!(", collocation RMS residual {r:.2e}"))
                         .unwrap_or_default()
                 );
             }
-            if let Some(x) = b["exact_vs_collocation_max_distance"].as_f64() {
+            if let Some(x) = b.exact_vs_collocation_max_distance {
                 println!("      max distance between the exact and the collocation solution: {x:.3e}");
             }
         }
-        if let Some(x) = p["section_reference_distance"].as_f64() {
-            let lin = p["section_reference_distance_linear_s"].as_f64().unwrap_or(f64::NAN);
+        if let Some(x) = p.section_reference_distance {
+            let lin = p.section_reference_distance_linear_s.unwrap_or(f64::NAN);
             println!(
                 "      max distance to the section family at the fractional section index: {x:.4} \
                      (s linear in u between sections: {lin:.4})"
             );
         }
-        for w in p["warnings"].as_array().into_iter().flatten() {
-            println!("      warning: {}", w.as_str().unwrap_or(""));
+        for w in &p.warnings {
+            println!("      warning: {w}");
         }
     }
+}
+
+/// A small array as compact JSON (`[1.0,2.0,3.0]`), the way the text report has always
+/// printed points and term counts.
+fn json_text<T: serde::Serialize>(x: &T) -> String {
+    serde_json::to_string(x).unwrap_or_default()
 }
 
 /// The figures of a scene's CAD fit, one line each: faces (net, certified deviation,
@@ -668,7 +652,7 @@ fn cad_lines(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<String> {
             ));
         }
     }
-    for s in cad_seams(fitted) {
+    for s in pdeshape_io::cad::reported_seams(fitted) {
         let [(a, ua), (b, ub)] = s.faces;
         out.push(format!(
             "seam {} u={ua} | {} u={ub}: gap {:.2e}, normal angle {:.2e} rad, cross curvature gap {:.2e} ({} points, after export)",
@@ -676,58 +660,6 @@ fn cad_lines(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<String> {
         ));
     }
     out
-}
-
-/// Seams between fitted faces, without those between alternative patches that join the
-/// same surfaces (both patches, the same boundary).
-fn cad_seams(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<pdeshape_io::cad::Seam> {
-    pdeshape_io::cad::seams(fitted, 200)
-        .into_iter()
-        .filter(|s| {
-            let [(a, ua), (b, ub)] = s.faces;
-            // a solid's faces meet at its edges, at an angle by construction: not seams
-            let solid = fitted[a].outward.is_some() && fitted[b].outward.is_some();
-            !solid && (fitted[a].primary || fitted[b].primary || ua != ub)
-        })
-        .collect()
-}
-
-/// The CAD fit as JSON for `check --json --cad`.
-fn cad_report(fitted: &[pdeshape_io::cad::CadFace]) -> serde_json::Value {
-    let faces: Vec<serde_json::Value> = fitted
-        .iter()
-        .map(|f| {
-            let r = &f.report;
-            let holes: Vec<serde_json::Value> = f
-                .holes
-                .iter()
-                .map(|h| {
-                    serde_json::json!({
-                        "name": h.name, "control_points": h.curve.control.len(), "certified_deviation": h.deviation,
-                    })
-                })
-                .collect();
-            serde_json::json!({
-                "name": f.name,
-                "primary": f.primary,
-                "control_points": [r.points.0, r.points.1],
-                "tolerance": r.tolerance,
-                "certified_deviation": r.max_deviation,
-                "holes": holes,
-            })
-        })
-        .collect();
-    let seams: Vec<serde_json::Value> = cad_seams(fitted)
-        .iter()
-        .map(|s| {
-            let [(a, ua), (b, ub)] = s.faces;
-            serde_json::json!({
-                "faces": [fitted[a].name, fitted[b].name], "u": [ua, ub],
-                "gap": s.gap, "normal_angle_radians": s.angle, "curvature_gap": s.curvature_gap, "samples": s.samples,
-            })
-        })
-        .collect();
-    serde_json::json!({ "faces": faces, "seams": seams })
 }
 
 /// Reads CSV rows of `N` finite numbers from stdin and writes `header` then one line per

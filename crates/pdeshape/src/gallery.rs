@@ -124,14 +124,14 @@ fn build_one(name: &str, text: &str, dir: &Path, limits: pdeshape_core::limits::
     let d = model::scene_diagnostics(&scene);
     let mut t =
         String::from("<table><tr><th>patch</th><th>kind</th><th>solver</th><th>max condition error (rel.)</th></tr>");
-    for p in d["patches"].as_array().into_iter().flatten() {
+    for p in &d.patches {
         let _ = write!(
             t,
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2e}</td></tr>",
-            esc(p["name"].as_str().unwrap_or("")),
-            esc(p["kind"].as_str().unwrap_or("")),
-            esc(p["solver"].as_str().unwrap_or("")),
-            p["condition_error"]["max_rel"].as_f64().unwrap_or(f64::NAN)
+            esc(&p.name),
+            esc(p.kind.name()),
+            esc(&p.solver),
+            p.condition_error.max_rel
         );
     }
     t.push_str("</table>");

@@ -18,7 +18,7 @@ fn every_frame_meets_the_c1_conditions() {
         ("dynamic-sine.toml", "collocation"),
     ] {
         let scene = Scene::load(&example(name)).unwrap();
-        let d = model::patch_diagnostics(&scene.patches[0]);
+        let d = model::patch_diagnostics(&scene.patches[0]).to_json();
         assert_eq!(d["dynamic"]["solver"], solver, "{name}");
         let frames = d["dynamic"]["frames"].as_array().unwrap();
         assert!(frames.len() >= 4);
@@ -150,7 +150,7 @@ fn beta_zero_is_reported() {
     let text = std::fs::read_to_string(example("dynamic-elliptic-cylinders.toml")).unwrap();
     let params = std::collections::HashMap::from([("beta".to_string(), 0.0)]);
     let scene = Scene::parse(&text, "d.toml", "d", &params).unwrap();
-    let d = model::patch_diagnostics(&scene.patches[0]);
+    let d = model::patch_diagnostics(&scene.patches[0]).to_json();
     assert_eq!(d["solver"], "collocation");
     let w = d["warnings"].as_array().unwrap();
     assert!(w.iter().any(|w| w.as_str().unwrap().starts_with("beta = 0")), "{w:?}");

@@ -2,6 +2,8 @@
 //! non-finite values, meets its conditions to 1e-10 (relative) at 1000 v samples, and
 //! renders.
 
+mod common;
+
 use pdeshape_io::model;
 use pdeshape_io::scene::Scene;
 use std::path::PathBuf;
@@ -10,6 +12,7 @@ use std::path::PathBuf;
 fn every_example_builds_and_meets_its_conditions() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let mut visited = Vec::new();
+    let mut keys = std::collections::BTreeSet::new();
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_none_or(|e| e != "toml") {
@@ -23,9 +26,11 @@ fn every_example_builds_and_meets_its_conditions() {
             m.check_finite().unwrap();
         }
         let d = model::scene_diagnostics(&scene);
-        for p in d["patches"].as_array().unwrap() {
-            let e = p["condition_error"]["max_rel"].as_f64().unwrap();
-            assert!(e <= 1e-10, "{}: patch {} misses its conditions by {e:e}", path.display(), p["name"]);
+        common::key_paths(&d.to_json(), "", &mut keys);
+        for p in &d.patches {
+            // `<=` is false for NaN
+            let e = p.condition_error.max_rel;
+            assert!(e <= 1e-10, "{}: patch {} misses its conditions by {e:e}", path.display(), p.name);
         }
         let mut small = scene;
         small.render.size = (64, 48);
@@ -38,6 +43,13 @@ fn every_example_builds_and_meets_its_conditions() {
     // every example named here was built and checked (a new example is added to the list)
     visited.sort();
     assert_eq!(visited, EXAMPLES);
+    // `check --json` keeps its keys: the union over the examples of every key path of the
+    // report equals the list written from the report before it was typed (hand-built JSON)
+    let want: std::collections::BTreeSet<String> =
+        include_str!("data/report_keys.txt").lines().map(str::to_string).collect();
+    let missing: Vec<_> = want.difference(&keys).collect();
+    let extra: Vec<_> = keys.difference(&want).collect();
+    assert!(missing.is_empty() && extra.is_empty(), "report keys: missing {missing:?}, new {extra:?}");
 }
 
 /// The examples of the repository, in file-name order.

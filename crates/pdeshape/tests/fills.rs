@@ -18,7 +18,7 @@ fn sphere_holes_are_filled_with_exact_g1() {
     for (name, occt_g1) in [("triangle", 2.7e-3), ("pentagon", 2.1e-3), ("hexagon", 4.8e-3)] {
         let scene = Scene::load(&example(&format!("fill-sphere-{name}.toml"))).unwrap();
         let p = scene.patch("cap").unwrap();
-        let d = model::patch_diagnostics(p);
+        let d = model::patch_diagnostics(p).to_json();
         let f = &d["fill"];
         // the normal is the cross product of two exactly met conditions (position and cross
         // tangent, both in the sphere's tangent plane): round-off, a few 1e-16 … 1e-15
@@ -63,7 +63,7 @@ fn box_corner_is_filled_with_exact_g1_near_the_sphere_octant() {
     let scene = Scene::load(&example("fill-box-corner.toml")).unwrap();
     let p = scene.patch("corner").unwrap();
     let r = scene.params["r"].value;
-    let d = model::patch_diagnostics(p);
+    let d = model::patch_diagnostics(p).to_json();
     let f = &d["fill"];
     let (g1, gap) = (f["g1_max_radians"].as_f64().unwrap(), f["gap_max_relative"].as_f64().unwrap());
     assert!(g1 <= 1e-9 && gap <= 1e-12, "G1 {g1}, gap {gap}");
@@ -128,7 +128,7 @@ fn bad_loops_are_errors_with_the_place() {
 fn wing_root_is_filled_with_exact_g2() {
     let scene = Scene::load(&example("fill-wing-root.toml")).unwrap();
     let p = scene.patch("root").unwrap();
-    let d = model::patch_diagnostics(p);
+    let d = model::patch_diagnostics(p).to_json();
     let f = &d["fill"];
     assert_eq!(f["order"], 6);
     let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
@@ -218,7 +218,7 @@ fn a_trim_hole_is_plugged_with_g2() {
         );
     let scene = Scene::parse(&text, "plug.toml", "plug", &Default::default()).unwrap();
     let p = scene.patch("plug").unwrap();
-    let d = model::patch_diagnostics(p);
+    let d = model::patch_diagnostics(p).to_json();
     let f = &d["fill"];
     let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
     let (g1, gap, g2) = (get("g1_max_radians"), get("gap_max_relative"), get("g2_max_relative"));

@@ -11,7 +11,7 @@ fn example_text(name: &str) -> String {
 
 fn diagnostics(text: &str) -> serde_json::Value {
     let scene = Scene::parse(text, "test.toml", "test", &HashMap::new()).unwrap_or_else(|e| panic!("{e}"));
-    model::patch_diagnostics(&scene.patches[0])
+    model::patch_diagnostics(&scene.patches[0]).to_json()
 }
 
 /// The Klein bottle at Chebyshev sections stays near the analytic bottle; the same 40
@@ -105,7 +105,7 @@ fn klein_bottle_is_exact_in_f64_across_the_slider() {
         // derivative orders beyond the tabulated ones are derived, not a panic
         let deep = scene.patches[0].surface.derivatives(0.37, 1.1, 4, 1);
         assert!(deep.len() == 10 && deep.iter().all(|x| x.is_finite()), "a = {a}");
-        let d = model::patch_diagnostics(&scene.patches[0]);
+        let d = model::patch_diagnostics(&scene.patches[0]).to_json();
         let t = d["spectral"]["truncated_residual_relative"].as_f64().unwrap();
         assert!(t <= 1e-9, "a = {a}: {t:e}");
     }

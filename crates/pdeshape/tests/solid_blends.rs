@@ -21,7 +21,7 @@ fn solid_examples_meet_conditions_and_have_closed_boundaries() {
     for name in SOLIDS {
         let scene = Scene::load(&example(name)).unwrap();
         let p = &scene.patches[0];
-        let d = model::patch_diagnostics(p);
+        let d = model::patch_diagnostics(p).to_json();
         assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10, "{name}: {}", d["condition_error"]);
         assert_eq!(d["mass_properties"]["folds"], false, "{name}: {}", d["mass_properties"]);
         let m = model::patch_mesh(p).unwrap();
@@ -47,7 +47,7 @@ fn solid_examples_meet_conditions_and_have_closed_boundaries() {
 #[test]
 fn cube_volume_matches_the_analytic_integral() {
     let scene = Scene::load(&example("solid-cubes.toml")).unwrap();
-    let d = model::patch_diagnostics(&scene.patches[0]);
+    let d = model::patch_diagnostics(&scene.patches[0]).to_json();
     // f g = (1 − 0.01w + 1.535w² − 1.025w³)(1 − 0.01w + 3.04w² − 2.03w³), integrated exactly
     let f = [1.0, -0.01, 1.535, -1.025];
     let g = [1.0, -0.01, 3.04, -2.03];

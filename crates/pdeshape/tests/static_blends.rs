@@ -20,7 +20,7 @@ fn continuity_table_of_the_cone_cylinder_blends() {
     assert_eq!(scene.patches.len(), 6);
     for (p, (name, class)) in scene.patches.iter().zip(want) {
         assert_eq!(p.name, name);
-        let d = model::patch_diagnostics(p);
+        let d = model::patch_diagnostics(p).to_json();
         assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10, "{name}: {}", d["condition_error"]);
         assert_eq!(d["continuity"]["class"], class, "{name}: {}", d["continuity"]);
         assert_eq!(d["solver"], "exact");
@@ -59,7 +59,7 @@ fn torus_hyperboloid_blends_and_per_vertex_continuity_fields() {
     let classes: Vec<String> = scene
         .patches
         .iter()
-        .map(|p| model::patch_diagnostics(p)["continuity"]["class"].as_str().unwrap().to_string())
+        .map(|p| model::patch_diagnostics(p).to_json()["continuity"]["class"].as_str().unwrap().to_string())
         .collect();
     assert_eq!(classes, ["C0", "C2"]);
     let m = model::patch_mesh(&scene.patches[1]).unwrap();
@@ -131,7 +131,7 @@ fn overriding_coefficients_by_parameters_keeps_exactness() {
         "orders = [6, 6, 6]\ncoefficients = [[1, 0.5, 2, 0.7], [2, 1, 1, 1], [1, 3, 3, 1]]",
     );
     let scene = Scene::parse(&text, "t.toml", "t", &HashMap::new()).unwrap();
-    let d = model::patch_diagnostics(&scene.patches[1]);
+    let d = model::patch_diagnostics(&scene.patches[1]).to_json();
     assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-10);
     assert_eq!(d["continuity"]["class"], "C2");
 }

@@ -144,6 +144,22 @@ fn step_refusals_name_the_cause_and_write_nothing() {
     assert!(!out.exists());
 }
 
+/// `check --cad --json` keeps its keys: the dolphin (faces with holes, a seam) gives every
+/// key path of the CAD report written before the report was typed.
+#[test]
+fn the_cad_report_keeps_its_keys() {
+    let scene = pdeshape_io::scene::Scene::load(&example("dolphin.toml")).unwrap();
+    let fitted = pdeshape_io::cad::fit_scene(&scene, &Default::default()).unwrap();
+    let report = pdeshape_io::cad::CadReport::of(&fitted);
+    assert!(!report.seams.is_empty() && report.faces.iter().any(|f| !f.holes.is_empty()));
+    let json = serde_json::json!({ "cad": serde_json::to_value(&report).unwrap() });
+    let mut keys = std::collections::BTreeSet::new();
+    common::key_paths(&json, "", &mut keys);
+    let want: std::collections::BTreeSet<String> =
+        include_str!("data/report_keys_cad.txt").lines().map(str::to_string).collect();
+    assert_eq!(keys, want);
+}
+
 /// `check --cad --json`: the figures of the export without writing it. The Bloor–Wilson
 /// blend (C1) and its two surfaces share v knots and interpolate parallel cross
 /// derivatives at the seams: the fitted faces meet G1 to round-off (a few 1e-14 rad; the

@@ -41,7 +41,7 @@ fn check_trimmed(scene: &Scene, name: &str) {
         for p in scene.patches.iter() {
             let Some(t) = &p.trim else { continue };
             trimmed += 1;
-            let d = model::patch_diagnostics(p);
+            let d = model::patch_diagnostics(p).to_json();
             let tj = &d["trim"];
             assert_eq!(tj["folds_after"], 0, "{name}: {tj}");
             assert_eq!(tj["inside_after"], 0, "{name}: {tj}");
@@ -86,7 +86,7 @@ fn dolphin_fins_start_on_the_body() {
     assert_eq!(t.map.region().bridges.len(), 2);
     for (fin, curve) in [("dorsal", "dorsal"), ("right_fin", "right"), ("left_fin", "left")] {
         let f = scene.patch(fin).unwrap();
-        let d = model::patch_diagnostics(f);
+        let d = model::patch_diagnostics(f).to_json();
         assert!(d["condition_error"]["max_rel"].as_f64().unwrap() < 1e-10, "{fin}: {}", d["condition_error"]);
         let c = &t.curves.iter().find(|(n, _)| n == curve).unwrap().1;
         for i in 0..200 {
@@ -120,7 +120,7 @@ fn dolphin_fins_start_on_the_body() {
         assert_eq!(model::seam_ends(f), vec![0.0]);
     }
     assert!(scene.patch("flukes").is_some());
-    assert!(model::seam_ends(body).is_empty() && model::patch_diagnostics(body)["continuity"].is_null());
+    assert!(model::seam_ends(body).is_empty() && model::patch_diagnostics(body).continuity.is_none());
 }
 
 const SHEET: &str = r#"

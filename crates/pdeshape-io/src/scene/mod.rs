@@ -71,8 +71,9 @@ pub struct LoadOptions {
     pub limits: pdeshape_core::limits::Limits,
 }
 
-/// What a patch is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What a patch is (serialised by its name in scene files).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum PatchKind {
     /// Ruled/Hermite interpolation in `u` (no PDE).
     Hermite,

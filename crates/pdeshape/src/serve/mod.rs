@@ -625,7 +625,7 @@ fn encode(s: &Solved, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
         "editables": edit::editables(&s.text),
         "hash": model::mesh_hash(&s.meshes),
         "solve_ms": s.solve_ms,
-        "diagnostics": if diagnostics { model::scene_diagnostics(&s.scene) } else { Value::Null },
+        "diagnostics": diagnostics.then(|| model::scene_diagnostics(&s.scene)),
         "curves": curves,
     });
     let mut h = serde_json::to_vec(&header).expect("JSON of plain values");

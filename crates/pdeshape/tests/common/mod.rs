@@ -61,3 +61,28 @@ pub fn build_fails(scene: &str, expect: &[&str]) {
     }
     assert!(!out.exists());
 }
+
+/// Every key path of a JSON value (`patches.[].spectral.order`), array indices as `[]`,
+/// without the parameters' own names (they are the scenes').
+pub fn key_paths(v: &serde_json::Value, at: &str, out: &mut std::collections::BTreeSet<String>) {
+    let join = |k: &str| if at.is_empty() { k.to_string() } else { format!("{at}.{k}") };
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                let path = join(k);
+                out.insert(path.clone());
+                if path != "parameters" {
+                    key_paths(x, &path, out);
+                }
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for x in a {
+                let path = join("[]");
+                out.insert(path.clone());
+                key_paths(x, &path, out);
+            }
+        }
+        _ => {}
+    }
+}

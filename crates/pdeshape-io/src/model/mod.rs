@@ -2,16 +2,18 @@
 
 use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
-use pdeshape_core::blend::{
-    ContinuityClass, DynamicFrame, Gaps, SeamGaps, Solver, StaticBlend, attached_gaps_at, attached_seam_gaps, gaps_at,
-    seam_gaps,
-};
+use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, attached_gaps_at, gaps_at};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
 use pdeshape_core::num::MaxNan;
-use pdeshape_core::patch::{Condition, CurvatureKind, Surface};
-use pdeshape_core::patch::{PrimarySurface, check_conditions};
-use serde_json::{Value, json};
+use pdeshape_core::patch::PrimarySurface;
+use pdeshape_core::patch::{CurvatureKind, Surface};
+
+mod diagnose;
+pub mod report;
+pub use diagnose::{
+    LEBESGUE_WARNING, attached_ends, blend_condition_report, condition_report, patch_diagnostics, scene_diagnostics,
+};
 
 /// Number of `v` samples per condition in the exactness check (SPEC §3: ≥ 1000).
 pub const CHECK_SAMPLES: usize = 1000;
@@ -470,12 +472,11 @@ fn blend_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, 
             let mut panel = Image::new(img.width, img.height + caption_h, [255, 255, 255]);
             panel.paste(&img, 0, 0);
             let d = patch_diagnostics(p);
-            let c = &d["continuity"];
-            let f = |e: &str, key: &str| {
-                let a = c["start"][key].as_f64();
-                let b = c["end"][key].as_f64();
-                match (a, b) {
-                    (Some(a), Some(b)) => format!("{:.1e}", a.max(b)),
+            let c = d.continuity.as_ref();
+            let f = |e: &str, pick: fn(&report::GapsReport) -> Option<f64>| {
+                let at = |g: Option<&report::GapsReport>| g.and_then(pick);
+                match (at(c.and_then(|c| c.start.as_ref())), at(c.and_then(|c| c.end.as_ref()))) {
+                    (Some(a), Some(b)) => format!("{:.1e}", pdeshape_core::num::max_nan(a, b)),
                     _ => "-".into(),
                 }
                 .replace("e0", "")
@@ -484,11 +485,11 @@ fn blend_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, 
             let text = format!(
                 "{}  ({})\nC0 gap {}\nG1 angle {}\nC2 gap {}   G2 {}",
                 p.name,
-                c["class"].as_str().unwrap_or("?"),
-                f("", "c0"),
-                f(" rad", "g1_radians"),
-                f("", "c2"),
-                f("", "g2"),
+                c.map_or("?", |c| c.class),
+                f("", |g| g.c0),
+                f(" rad", |g| g.g1),
+                f("", |g| g.c2),
+                f("", |g| g.g2),
             );
             crate::render::draw_text(&mut panel, 14.0, img.height as f32 + 6.0, 20.0, &text, [30, 30, 40]);
             panels.push(panel);
@@ -579,135 +580,6 @@ fn palette(k: usize) -> [f64; 3] {
     PALETTE[k % PALETTE.len()].map(f64::from)
 }
 
-/// Lebesgue constant above which `check` warns that the condition set amplifies its data
-/// (SPEC §3 "Many sections").
-pub const LEBESGUE_WARNING: f64 = 1e3;
-
-/// Diagnostics of a solid patch: the four boundary conditions on a 50 × 50 grid of
-/// `(u, v)`, the solve, mass properties, the RMS PDE residual at interior points.
-/// A solid's four face conditions on a 50 × 50 grid of each face.
-fn solid_condition_report(sd: &crate::scene::SolidSetup) -> pdeshape_core::patch::ConditionReport {
-    let s = sd.blend.as_ref();
-    let (mut worst, mut size) = (0.0f64, 0.0f64);
-    for i in 0..50 {
-        for j in 0..50 {
-            let (u, v) = (i as f64 / 49.0, j as f64 / 49.0);
-            for (w, k, f) in [(0.0, 0, 0), (0.0, 1, 1), (1.0, 0, 2), (1.0, 1, 3)] {
-                let d = s.derivatives(u, v, w, 0, 0, 1)[k];
-                let g = sd.faces[f].eval(&[u, v]);
-                worst = pdeshape_core::num::max_nan(worst, (d - g).norm());
-                size = pdeshape_core::num::max_nan(size, g.norm());
-            }
-        }
-    }
-    let rel = worst / pdeshape_core::num::max_nan(size, f64::MIN_POSITIVE);
-    pdeshape_core::patch::ConditionReport { max_abs: worst, max_rel: rel, size }
-}
-
-/// The patch's condition check alone (what `check` reports as `condition_error`, without
-/// the rest of the diagnostics): every condition at [`CHECK_SAMPLES`] points, every frame
-/// of a dynamic blend, a solid's four faces. NaN when anything evaluated is NaN.
-pub fn condition_report(p: &ScenePatch) -> pdeshape_core::patch::ConditionReport {
-    if let Some(sd) = &p.solid {
-        return solid_condition_report(sd);
-    }
-    if let Some(b) = &p.blend {
-        return blend_condition_report(b.blend.as_ref(), &p.conditions);
-    }
-    if let Some(dy) = &p.dynamic {
-        let mut worst = pdeshape_core::patch::ConditionReport { max_abs: 0.0, max_rel: 0.0, size: 0.0 };
-        for t in dy.frame_times() {
-            let r = match dy.blend.frame(t) {
-                Ok(f) => check_conditions(&f, &p.conditions, t, CHECK_SAMPLES),
-                Err(_) => {
-                    pdeshape_core::patch::ConditionReport { max_abs: f64::NAN, max_rel: f64::NAN, size: f64::NAN }
-                }
-            };
-            // the worst frame; a NaN frame is the worst of all
-            if r.max_rel.is_nan() || r.max_rel >= worst.max_rel {
-                worst = r;
-            }
-        }
-        return worst;
-    }
-    check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES)
-}
-
-fn solid_diagnostics(p: &ScenePatch, sd: &crate::scene::SolidSetup) -> Value {
-    let s = sd.blend.as_ref();
-    let check = solid_condition_report(sd);
-    let (worst, size) = (check.max_abs, check.size);
-    let mp = s.mass_properties(16);
-    // interior points (boundary surfaces may have singular derivatives on the edges)
-    let mut r2 = 0.0;
-    let n = 512;
-    for [u, v, w] in pdeshape_core::solid::interior_points(n) {
-        r2 += s.residual(u, v, w).norm().powi(2);
-    }
-    let rep = s.report();
-    let mut warnings = Vec::new();
-    if mp.folds() {
-        warnings.push(json!(format!(
-            "the solid folds: det J ranges over [{:.3e}, {:.3e}]; raise lmn or change the boundary surfaces",
-            mp.min_jacobian, mp.max_jacobian
-        )));
-    }
-    json!({
-        "name": p.name,
-        "kind": "solid",
-        "solver": rep.method,
-        "conditions": [{"w": 0, "order": 0}, {"w": 0, "order": 1}, {"w": 1, "order": 0}, {"w": 1, "order": 1}],
-        "condition_error": {"samples": 2500, "max_abs": worst, "max_rel": check.max_rel, "patch_size": size},
-        "solid": {
-            "terms": [rep.terms.0, rep.terms.1, rep.terms.2],
-            "condition_number": rep.condition_number,
-            "max_coefficient": rep.max_coefficient,
-            "rms_residual": (r2 / n as f64).sqrt(),
-            "cells": [sd.cells.0, sd.cells.1, sd.cells.2],
-        },
-        "mass_properties": {
-            "volume": mp.volume,
-            "centroid": [mp.centroid.x, mp.centroid.y, mp.centroid.z],
-            "inertia": mp.inertia,
-            "min_jacobian": mp.min_jacobian,
-            "max_jacobian": mp.max_jacobian,
-            "folds": mp.folds(),
-        },
-        "warnings": warnings,
-    })
-}
-
-/// The trim section of `check`: fold counts before and after repair, cell angles, the
-/// area ratio, and how far the mesh boundary lies from the trim loop (parameter space).
-fn trim_diagnostics(t: &crate::scene::TrimSetup) -> Value {
-    let g = &t.grid;
-    let r = &g.report;
-    let region = t.map.region();
-    let k = t.scale;
-    let boundary =
-        (0..g.columns).map(|j| region.loop_distance([g.points[j][0] * k[0], g.points[j][1] * k[1]])).max_nan();
-    json!({
-        "curves": region.curves.iter().map(|c| c.0.clone()).collect::<Vec<_>>(),
-        "bridges": region.bridges.len(),
-        "metric_scale": k,
-        "rings": r.rings,
-        "columns": r.columns,
-        "modes": r.modes,
-        "omega": r.omega,
-        "folds_before": r.folds_before,
-        "folds_after": r.folds_after,
-        "inside_before": r.inside_before,
-        "inside_after": r.inside_after,
-        "repair_sweeps": r.sweeps,
-        "untangle_moves": r.untangle_moves,
-        "min_angle_deg": r.min_angle,
-        "max_angle_deg": r.max_angle,
-        "area_ratio": r.area_ratio,
-        "cell_area_ratio": r.cell_area_ratio,
-        "boundary_error": boundary,
-    })
-}
-
 /// The trim of a patch in its parameter domain: the `(ρ, φ)` grid, the trim curves, the
 /// bridges and the domain border (paper 003, Figs. 3, 5a–7a).
 pub fn trim_picture(p: &ScenePatch) -> Option<Result<Image, String>> {
@@ -770,409 +642,6 @@ pub fn trim_picture(p: &ScenePatch) -> Option<Result<Image, String>> {
         &layers,
         (600, 600),
     ))
-}
-
-/// Diagnostics of one patch, as `check --json` prints them.
-pub fn patch_diagnostics(p: &ScenePatch) -> Value {
-    if let Some(sd) = &p.solid {
-        return solid_diagnostics(p, sd);
-    }
-    let mut rep = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES);
-    if let Some(b) = &p.blend {
-        rep = blend_condition_report(b.blend.as_ref(), &p.conditions);
-    }
-    let mut dyn_json = Value::Null;
-    if let Some(dy) = &p.dynamic {
-        // every frame against the data at its own time
-        let mut frames = Vec::new();
-        let mut worst = pdeshape_core::patch::ConditionReport { max_abs: 0.0, max_rel: 0.0, size: 0.0 };
-        let mut report = None;
-        for t in dy.frame_times() {
-            match dy.blend.frame(t) {
-                Ok(f) => {
-                    let r = check_conditions(&f, &p.conditions, t, CHECK_SAMPLES);
-                    frames.push(json!({"t": t, "max_abs": r.max_abs, "max_rel": r.max_rel}));
-                    if r.max_rel >= worst.max_rel {
-                        worst = r;
-                    }
-                    report.get_or_insert_with(|| f.report().clone());
-                }
-                Err(e) => frames.push(json!({"t": t, "error": e.to_string()})),
-            }
-        }
-        rep = worst;
-        let op = dy.blend.operator();
-        let r = report.unwrap_or_else(|| pdeshape_core::blend::DynamicReport {
-            solver: "none",
-            basis: vec![],
-            exact_available: false,
-            condition_number: f64::NAN,
-        });
-        dyn_json = json!({
-            "operator": {"beta": op.beta, "gamma": op.gamma, "lambda": op.lambda, "rho": op.rho, "eta": op.eta},
-            "solver": r.solver,
-            "exact_available": r.exact_available,
-            "basis": r.basis,
-            "condition_number": r.condition_number,
-            "time": [dy.times.0, dy.times.1],
-            "frames": frames,
-        });
-    }
-    let dom = p.surface.v_domain();
-    let mut d = json!({
-        "name": p.name,
-        "kind": p.kind.name(),
-        "solver": match (&p.kind, &p.blend) {
-            (crate::scene::PatchKind::Hermite, _) => "hermite-interpolation".to_string(),
-            (crate::scene::PatchKind::Pde | crate::scene::PatchKind::Fill, _) => "spectral".to_string(),
-            (_, Some(b)) => blend_solver_name(b.blend.as_ref()),
-            (_, None) => p.dynamic.as_ref().and_then(|d| d.blend.frame(d.times.0).ok()).map(|f| f.report().solver.to_string()).unwrap_or_else(|| "none".into()),
-        },
-        "conditions": p.conditions.iter().map(|c| json!({"u": c.u, "order": c.order})).collect::<Vec<_>>(),
-        "v_domain": {"start": dom.start, "end": dom.end, "periodic": dom.periodic},
-        "resolution": [p.resolution.0, p.resolution.1],
-        "condition_error": {
-            "samples": CHECK_SAMPLES,
-            "max_abs": rep.max_abs,
-            "max_rel": rep.max_rel,
-            "patch_size": rep.size,
-        },
-        "warnings": [],
-    });
-    if let Some(t) = &p.trim {
-        d["trim"] = trim_diagnostics(t);
-    }
-    if let Some(fam) = &p.sections {
-        // How far the patch strays from the section family between its sections.
-        let distance = |s_of: &dyn Fn(f64) -> f64| {
-            let (mut worst, mut at): (f64, [f64; 3]) = (0.0, [0.0; 3]);
-            for i in 0..=400 {
-                let u = i as f64 / 400.0;
-                let s = s_of(u);
-                for j in 0..48 {
-                    let v = dom.at((j as f64 + 0.25) / 48.0);
-                    let x = p.surface.point(u, v);
-                    let r = pdeshape_core::data::Field::eval(fam.curve.as_ref(), &[v, 0.0, s]);
-                    let dist = (x - r).norm();
-                    if dist > worst {
-                        (worst, at) = (dist, [u, v, s]);
-                    }
-                }
-            }
-            (worst, at)
-        };
-        let (worst, at) = distance(&|u| fam.s_at(u));
-        d["section_reference_distance"] = json!(worst);
-        d["section_reference_distance_linear_s"] = json!(distance(&|u| fam.s_linear(u)).0);
-        d["section_reference_worst"] = json!({"u": at[0], "v": at[1], "s": at[2]});
-    }
-    if let Some(b) = &p.blend {
-        blend_diagnostics(p, b, &mut d, rep.size);
-    } else if p.dynamic.is_none() && p.trim.is_none() && !attached_ends(p).is_empty() {
-        attached_diagnostics(p, &mut d, rep.size);
-    }
-    if let Some(f) = &p.fill {
-        let r = f.report();
-        let e = f.edge_continuity(1000);
-        d["fill"] = json!({
-            "edges": r.corner_angles.len(),
-            "edge_samples": e.samples,
-            "g1_max_radians": e.g1,
-            "gap_max_relative": e.gap,
-            "g2_max_relative": e.g2,
-            "order": f.patch().order(),
-            "corner_normal_angles_radians": r.corner_angles,
-            "folds": f.folds(41, 400),
-            "pole": [r.pole.x, r.pole.y, r.pole.z],
-            "loop_radius": r.radius,
-        });
-        if let Some(k) = r.pole_curvature {
-            d["fill"]["pole_curvature"] = json!(k);
-            d["fill"]["corner_curvature_gaps_relative"] = json!(r.corner_curvature_gaps);
-        }
-        if let Some(w) = d["warnings"].as_array_mut() {
-            for (k, a) in r.corner_angles.iter().enumerate() {
-                if a.is_nan() || *a > 1e-9 {
-                    w.push(json!(format!(
-                        "corner {k}: the neighbours' tangent planes differ by {a:.2e} rad there, so no surface meets both G1 at that corner"
-                    )));
-                }
-            }
-            for (k, g) in r.corner_curvature_gaps.iter().enumerate() {
-                if g.is_nan() || *g > 1e-8 {
-                    w.push(json!(format!(
-                        "corner {k}: the neighbours' normal curvatures across the corner differ by {g:.2e} (relative), so no surface meets both G2 there; G2 is given up within that corner's blend"
-                    )));
-                }
-            }
-        }
-    }
-    if !dyn_json.is_null() {
-        d["dynamic"] = dyn_json;
-    }
-    if rep.max_rel.is_finite()
-        && rep.max_rel > CONDITION_WARNING
-        && let Some(w) = d["warnings"].as_array_mut()
-    {
-        w.push(json!(format!(
-            "the patch meets its conditions only to {:.2e} (relative): the data are not resolved on this domain \
-             (data varying much faster than the modes, or an extreme domain); the result does not interpolate them",
-            rep.max_rel
-        )));
-    }
-    if let Some(dy) = &p.dynamic
-        && dy.blend.operator().beta == 0.0
-        && let Some(w) = d["warnings"].as_array_mut()
-    {
-        w.push(json!(
-            "beta = 0: the operator has no ∂⁴/∂u⁴ term, so it cannot take the four C1 conditions; they are met by \
-             the trial functions (cubic Hermite part) and the sine terms only minimise the residual of a 2nd-order \
-             operator in u: the closed form does not apply and the shape depends on the collocation grid and K"
-        ));
-    }
-    if let Some(sp) = &p.spectral {
-        let r = sp.report();
-        // The 2N-th derivatives behind the residual are evaluated in f64; above N = 10 their
-        // round-off swamps the residual, so it is reported only up to order 20.
-        let residuals = r.order <= 20;
-        // RMS residuals on an interior grid
-        let (mut t2, mut w2, mut r2, mut n, mut have_t) = (0.0, 0.0, 0.0, 0.0, true);
-        for i in 1..if residuals { 12 } else { 0 } {
-            for j in 0..24 {
-                let v = dom.at((j as f64 + 0.5) / 24.0);
-                let res = sp.residual(i as f64 / 12.0, v);
-                r2 += res.remainder.unwrap_or(f64::NAN).powi(2);
-                match (res.truncated, res.whole) {
-                    (Some(t), Some(w)) => {
-                        t2 += t * t;
-                        w2 += w * w;
-                    }
-                    _ => have_t = false,
-                }
-                n += 1.0;
-            }
-        }
-        d["spectral"] = json!({
-            "order": r.order,
-            "modes": r.modes,
-            "omega": r.omega,
-            "max_mode_condition_number": r.max_mode_condition,
-            "modes_solved_in_f64": r.methods.0,
-            "modes_solved_in_multiprecision": r.methods.1,
-            "mode_paths": r.mode_paths,
-            // the truncated part's PDE residual, relative, from the modes' Chebyshev
-            // coefficients (every order; the last entry is the remainder's functions)
-            "mode_residuals_relative": r.mode_residuals,
-            "truncated_residual_relative": r.mode_residuals[..r.mode_residuals.len() - 1].iter().copied().max_nan(),
-            "lebesgue_mode0": r.lebesgue.0,
-        });
-        let s = &mut d["spectral"];
-        put(s, "lebesgue_mode1", r.lebesgue.1);
-        put(s, "rms_residual_truncated", (have_t && residuals).then(|| (t2 / n).sqrt()));
-        put(s, "rms_residual_remainder", residuals.then(|| (r2 / n).sqrt()));
-        put(s, "rms_residual_whole", (have_t && residuals).then(|| (w2 / n).sqrt()));
-        let leb = r.lebesgue.0.max(r.lebesgue.1.unwrap_or(0.0));
-        if leb > LEBESGUE_WARNING {
-            let msg = format!(
-                "the condition set amplifies its data by up to {leb:.3e} between conditions (Lebesgue constant): \
-                 many sections at equispaced u make high-order interpolation swing; place them at \
-                 Chebyshev-distributed u (sections.spacing = \"chebyshev\") or use fewer sections"
-            );
-            if let Some(w) = d["warnings"].as_array_mut() {
-                w.push(json!(msg));
-            }
-        }
-    }
-    d
-}
-
-/// `"exact"`, `"collocation"` or the per-component mix.
-fn blend_solver_name(b: &StaticBlend) -> String {
-    let r = b.reports();
-    if r.iter().all(|c| c.solver == r[0].solver) {
-        r[0].solver.to_string()
-    } else {
-        format!("mixed (x: {}, y: {}, z: {})", r[0].solver, r[1].solver, r[2].solver)
-    }
-}
-
-/// The condition check of a blend: each component against the conditions its order takes
-/// (a 2nd-order component takes positions only, and is not expected to meet the others).
-pub fn blend_condition_report(b: &StaticBlend, conds: &[Condition]) -> pdeshape_core::patch::ConditionReport {
-    let positions: Vec<Condition> = conds.iter().filter(|c| c.order == 0).cloned().collect();
-    let mut rep = check_conditions(b, &positions, 0.0, CHECK_SAMPLES);
-    let dom = b.v_domain();
-    for (t, op) in b.operators().iter().enumerate() {
-        for c in conds.iter().filter(|c| c.order < op.half_order()) {
-            for i in 0..CHECK_SAMPLES {
-                let v = dom.at((i as f64 + 0.37) / CHECK_SAMPLES as f64);
-                let e = (b.u_derivative(c.u, v, c.order)[t] - c.data.eval(&[v, 0.0])[t]).abs();
-                rep.max_abs = pdeshape_core::num::max_nan(rep.max_abs, e);
-            }
-        }
-    }
-    rep.max_rel = rep.max_abs / pdeshape_core::num::max_nan(rep.size, f64::MIN_POSITIVE);
-    rep
-}
-
-/// Inserts `key: v` when `v` was computed. A value that was not computed is left out
-/// rather than written as `null`: `null` in a report means a NaN or an infinity (serde_json
-/// writes them so), which the tests refuse.
-fn put(obj: &mut Value, key: &str, v: Option<impl Into<Value>>) {
-    if let (Some(v), Some(o)) = (v, obj.as_object_mut()) {
-        o.insert(key.to_string(), v.into());
-    }
-}
-
-fn gaps_json(g: &Gaps) -> Value {
-    let mut o = json!({});
-    for (k, v) in [("c0", g.c0), ("c1", g.c1), ("g1_radians", g.g1), ("c2", g.c2), ("g2", g.g2)] {
-        put(&mut o, k, v);
-    }
-    o
-}
-
-/// The ends `u = 0`, `u = 1` of a (non-blend) patch whose position there is a curve on
-/// another surface (a trim curve of an earlier patch: a fin on a body), with that data.
-pub fn attached_ends(p: &ScenePatch) -> Vec<(f64, FieldRef)> {
-    if p.blend.is_some() {
-        return Vec::new();
-    }
-    p.conditions
-        .iter()
-        .filter(|c| c.order == 0 && (c.u == 0.0 || c.u == 1.0) && c.data.host_normal(&[0.0, 0.0]).is_some())
-        .map(|c| (c.u, c.data.clone()))
-        .collect()
-}
-
-/// The seams of a patch attached to other patches' trim curves: position gap and G1 angle
-/// against the host surface at 400 points, the class and the worst places, under
-/// `continuity` (`start` for `u = 0`, `end` for `u = 1`; `with`: "trim curve").
-fn attached_diagnostics(p: &ScenePatch, d: &mut Value, size: f64) {
-    let s = p.surface.as_ref();
-    let ends = attached_ends(p);
-    let seams: Vec<SeamGaps> = ends.iter().map(|(u, data)| attached_seam_gaps(s, *u, data, 400)).collect();
-    let mut c = json!({
-        "class": ContinuityClass::of(&seams.iter().map(|g| g.max).collect::<Vec<_>>(), size).name(),
-        "samples": 400,
-        "with": if p.fill.is_some() { "neighbouring surface" } else { "trim curve" },
-    });
-    // worst_json names the ends by their index: put each seam where its u says
-    let mut by_end = [SeamGaps::default(), SeamGaps::default()];
-    for ((u, _), g) in ends.iter().zip(&seams) {
-        c[if *u == 0.0 { "start" } else { "end" }] = gaps_json(&g.max);
-        by_end[usize::from(*u == 1.0)] = *g;
-    }
-    c["worst"] = worst_json(s, &by_end);
-    d["continuity"] = c;
-}
-
-/// Per measure, the worst place over both trimlines: `{value, end, u, v, point}` (the
-/// larger end wins; NaN wins over numbers; the start wins ties).
-fn worst_json(b: &dyn Surface, seams: &[SeamGaps]) -> Value {
-    type Pick = fn(&Gaps) -> Option<f64>;
-    let picks: [(&str, Pick); 5] =
-        [("c0", |g| g.c0), ("c1", |g| g.c1), ("g1_radians", |g| g.g1), ("c2", |g| g.c2), ("g2", |g| g.g2)];
-    let mut o = json!({});
-    for (key, pick) in picks {
-        let mut best: Option<(f64, usize, f64)> = None;
-        for (e, sg) in seams.iter().enumerate() {
-            if let (Some(x), Some(v)) = (pick(&sg.max), pick(&sg.at)) {
-                let better = match best {
-                    None => true,
-                    Some((b, ..)) => !b.is_nan() && (x.is_nan() || x > b),
-                };
-                if better {
-                    best = Some((x, e, v));
-                }
-            }
-        }
-        if let Some((x, e, v)) = best {
-            let u = e as f64;
-            let q = b.point(u, v);
-            let end = ["start", "end"][e];
-            let mut w = json!({"end": end, "u": u, "v": v, "point": [q.x, q.y, q.z]});
-            put(&mut w, "value", Some(x));
-            o[key] = w;
-        }
-    }
-    o
-}
-
-fn blend_diagnostics(p: &ScenePatch, setup: &crate::scene::BlendSetup, d: &mut Value, size: f64) {
-    let b = setup.blend.as_ref();
-    let comps: Vec<Value> = b
-        .reports()
-        .iter()
-        .zip(["x", "y", "z"])
-        .zip(b.operators())
-        .map(|((r, axis), op)| {
-            let mut c = json!({
-                "component": axis,
-                "order": r.order,
-                "coefficients": op.coefficients(),
-                "elliptic": r.elliptic,
-                "solver": r.solver,
-                "exact_available": r.exact_available,
-                "basis": r.basis,
-                "condition_number": r.condition_number,
-            });
-            put(&mut c, "collocation_rms_residual", r.collocation_rms);
-            put(
-                &mut c,
-                "collocation",
-                r.collocation.map(|(l, q, nb)| json!({"u_points": l, "v_points": q, "bubbles": nb})),
-            );
-            c
-        })
-        .collect();
-    // When both solvers apply, how far apart their surfaces are.
-    let both = b.reports().iter().all(|r| r.exact_available);
-    let distance = both
-        .then(|| {
-            let ran_exact = b.reports().iter().all(|r| r.solver == "exact");
-            let other = pdeshape_core::blend::BlendOptions {
-                solver: if ran_exact { Solver::Collocation } else { Solver::Exact },
-                ..setup.options.clone()
-            };
-            let q = StaticBlend::new(b.operators().clone(), &p.conditions, b.v_domain(), &other).ok()?;
-            let dom = b.v_domain();
-            let mut worst: f64 = 0.0;
-            for i in 0..=50 {
-                for j in 0..50 {
-                    let (u, v) = (i as f64 / 50.0, dom.at((j as f64 + 0.5) / 50.0));
-                    worst = pdeshape_core::num::max_nan(worst, (b.point(u, v) - q.point(u, v)).norm());
-                }
-            }
-            Some(worst)
-        })
-        .flatten();
-    let seams: Vec<SeamGaps> = [0.0, 1.0]
-        .iter()
-        .map(|&u| {
-            let e = end_data(p, u);
-            seam_gaps(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], 400)
-        })
-        .collect();
-    let ends: Vec<Gaps> = seams.iter().map(|s| s.max).collect();
-    d["blend"] = json!({ "components": comps });
-    put(&mut d["blend"], "exact_vs_collocation_max_distance", distance);
-    d["continuity"] = json!({
-        "start": gaps_json(&ends[0]),
-        "end": gaps_json(&ends[1]),
-        "class": ContinuityClass::of(&ends, size).name(),
-        "samples": 400,
-        "worst": worst_json(b, &seams),
-    });
-    for (r, axis) in b.reports().iter().zip(["x", "y", "z"]) {
-        if !r.elliptic
-            && let Some(w) = d["warnings"].as_array_mut()
-        {
-            w.push(json!(format!(
-                "component {axis}: the operator is not elliptic; the blend is solved per mode but is not well posed for all data"
-            )));
-        }
-    }
 }
 
 /// The convergence study of a PDE patch over an interior grid for `M = 1 … 16` modes
@@ -1327,16 +796,6 @@ pub fn solid_sections_picture(scene: &Scene, p: &ScenePatch) -> Option<Result<Im
     let mut r = scene.render.clone();
     r.wireframe = true;
     Some(Ok(render_meshes(&meshes, &[], &colors, &r)))
-}
-
-/// Diagnostics of a scene.
-pub fn scene_diagnostics(scene: &Scene) -> Value {
-    json!({
-        "scene": scene.name,
-        "title": scene.title,
-        "parameters": scene.params.iter().map(|(k, p)| (k.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-        "patches": scene.patches.iter().map(patch_diagnostics).collect::<Vec<_>>(),
-    })
 }
 
 #[cfg(test)]
