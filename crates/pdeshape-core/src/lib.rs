@@ -30,6 +30,7 @@ pub mod num;
 pub mod ode;
 pub mod patch;
 pub mod solid;
+pub mod solves;
 pub mod spectral;
 pub mod taylor;
 pub mod trim;

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use pdeshape_core::limits::Limits;
+use pdeshape_core::solves::Solves;
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::model::report::{GapsReport, PatchReport, SceneReport};
@@ -260,7 +261,13 @@ pub fn run() -> i32 {
     for l in &cli.limit {
         limits.apply(l).expect("checked by clap");
     }
-    match execute(cli, limits) {
+    let result = execute(cli, limits);
+    if std::env::var_os("PDESHAPE_SOLVE_COUNTS").is_some() {
+        // a test hook: the solves of the whole command, and those done while loading
+        let loaded = LOADED.get().copied().unwrap_or_default();
+        eprintln!("solves: loaded {:?}, command {:?}", loaded.0, Solves::now().since(loaded).0);
+    }
+    match result {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -271,6 +278,12 @@ pub fn run() -> i32 {
         }
     }
 }
+
+/// The solve counts right after the (last) scene was loaded; `PDESHAPE_SOLVE_COUNTS=1`
+/// prints them and those of the rest of the command (in the order of
+/// `pdeshape_core::solves::SolveKind::ALL`), so tests can check that a command solves each
+/// patch once.
+static LOADED: std::sync::OnceLock<Solves> = std::sync::OnceLock::new();
 
 /// What a command loads a scene with: the caps, `--set` values, solver and sine-term
 /// overrides.
@@ -296,7 +309,9 @@ impl Load<'_> {
             terms: self.terms,
             limits: self.limits,
         };
-        Ok(Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?)
+        let scene = Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?;
+        let _ = LOADED.set(Solves::now());
+        Ok(scene)
     }
 }
 

@@ -502,6 +502,7 @@ impl DynamicBlend {
 
     #[allow(clippy::needless_range_loop)] // (l, m) index the grid row l·M + m and the tables
     fn solve_frame(&self, t: f64) -> Result<DynamicFrame, BlendError> {
+        crate::solves::record(crate::solves::SolveKind::DynamicFrame);
         let nj = self.basis.len();
         let w = |j: usize| -> [Vec3; 4] { std::array::from_fn(|c| self.coef[c][j]) };
         if let Some(cards) = &self.exact {

@@ -190,6 +190,7 @@ impl StaticBlend {
         domain: VDomain,
         opts: &BlendOptions,
     ) -> Result<Self, BlendError> {
+        crate::solves::record(crate::solves::SolveKind::StaticBlend);
         if let Some(c) = conditions.iter().find(|c| c.u != 0.0 && c.u != 1.0) {
             return Err(BlendError::Conditions(format!(
                 "a static blend takes its conditions at u = 0 and u = 1, not at u = {}",

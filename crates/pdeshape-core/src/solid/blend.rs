@@ -139,6 +139,7 @@ pub struct SolidBlend {
 impl SolidBlend {
     /// Solves for the correction. `faces` are `S₁ … S₄` (slots `(u, v)`).
     pub fn new(op: SolidOperator, faces: [FieldRef; 4], opts: SolidOptions) -> Result<Self, SolidError> {
+        crate::solves::record(crate::solves::SolveKind::Solid);
         let (nl, nm, nn) = opts.terms;
         if nl == 0 || nm == 0 || nn == 0 || nl * nm * nn > 40_000 {
             return Err(SolidError::Input(format!("terms ({nl}, {nm}, {nn}): each must be ≥ 1 and L·M·N ≤ 40000")));

@@ -175,6 +175,7 @@ pub fn clear_cardinal_memo() {
 impl SpectralPatch {
     /// Solves the patch for `conds` (data slots `(v, t)`) over `domain` at time `t`.
     pub fn new(conds: &[Condition], domain: VDomain, opts: SpectralOptions) -> Result<Self, SpectralError> {
+        crate::solves::record(crate::solves::SolveKind::Spectral);
         // one entry into the thread pool for the analysis and the cardinal sets (see
         // `grid_products`)
         rayon::scope(|_| Self::new_in_pool(conds, domain, opts))

@@ -43,6 +43,7 @@ impl LaplaceMap {
     /// remainder rate `ω = N + 1`. With `columns`, the border corners fall on the mesh
     /// columns `φ = 2πj/columns`.
     pub fn new(region: TrimRegion, modes: usize, columns: Option<usize>) -> Self {
+        crate::solves::record(crate::solves::SolveKind::LaplaceMap);
         let modes = modes.min(FFT_SAMPLES / 2 - 1);
         let inner = InnerParam::new(&region, columns);
         let c = region.center;

@@ -490,6 +490,42 @@ fn worst_places(b: &dyn Surface, seams: &[SeamGaps]) -> WorstPlaces {
     WorstPlaces { c0: pick(|g| g.c0), c1: pick(|g| g.c1), g1: pick(|g| g.g1), c2: pick(|g| g.c2), g2: pick(|g| g.g2) }
 }
 
+/// A blend's seams at both trimlines against the surfaces' data there; `size` (the patch's)
+/// sets the class's thresholds.
+fn blend_continuity(p: &ScenePatch, b: &StaticBlend, size: f64) -> ContinuityReport {
+    let seams: Vec<SeamGaps> = [0.0, 1.0]
+        .iter()
+        .map(|&u| {
+            let e = end_data(p, u);
+            seam_gaps(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], SEAM_SAMPLES)
+        })
+        .collect();
+    let ends: Vec<Gaps> = seams.iter().map(|s| s.max).collect();
+    ContinuityReport {
+        class: ContinuityClass::of(&ends, size).name(),
+        samples: SEAM_SAMPLES,
+        with: None,
+        start: Some(ends[0].into()),
+        end: Some(ends[1].into()),
+        worst: worst_places(b, &seams),
+    }
+}
+
+/// The continuity section of a patch's report alone (what the blend strip's captions
+/// print), without the rest of the report and its extra solves: `None` for patches
+/// without seams.
+pub fn continuity_report(p: &ScenePatch) -> Option<ContinuityReport> {
+    if let Some(b) = &p.blend {
+        let size = blend_condition_report(b.blend.as_ref(), &p.conditions).size;
+        return Some(blend_continuity(p, b.blend.as_ref(), size));
+    }
+    if p.solid.is_some() || p.dynamic.is_some() || p.trim.is_some() || attached_ends(p).is_empty() {
+        return None;
+    }
+    let size = check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES).size;
+    Some(attached_continuity(p, size))
+}
+
 /// A static blend's sections: the components' solves, the distance between the two
 /// solvers' surfaces when both apply, the seams at both trimlines; warnings for operators
 /// that are not elliptic.
@@ -534,23 +570,8 @@ fn blend_sections(p: &ScenePatch, setup: &BlendSetup, d: &mut PatchReport, size:
             Some(worst)
         })
         .flatten();
-    let seams: Vec<SeamGaps> = [0.0, 1.0]
-        .iter()
-        .map(|&u| {
-            let e = end_data(p, u);
-            seam_gaps(b, u, [e[0].as_ref(), e[1].as_ref(), e[2].as_ref()], SEAM_SAMPLES)
-        })
-        .collect();
-    let ends: Vec<Gaps> = seams.iter().map(|s| s.max).collect();
     d.blend = Some(BlendReport { components, exact_vs_collocation_max_distance: distance });
-    d.continuity = Some(ContinuityReport {
-        class: ContinuityClass::of(&ends, size).name(),
-        samples: SEAM_SAMPLES,
-        with: None,
-        start: Some(ends[0].into()),
-        end: Some(ends[1].into()),
-        worst: worst_places(b, &seams),
-    });
+    d.continuity = Some(blend_continuity(p, b, size));
     for (r, axis) in b.reports().iter().zip(["x", "y", "z"]) {
         if !r.elliptic {
             d.warnings.push(format!(

@@ -12,7 +12,8 @@ use pdeshape_core::patch::{CurvatureKind, Surface};
 mod diagnose;
 pub mod report;
 pub use diagnose::{
-    LEBESGUE_WARNING, attached_ends, blend_condition_report, condition_report, patch_diagnostics, scene_diagnostics,
+    LEBESGUE_WARNING, attached_ends, blend_condition_report, condition_report, continuity_report, patch_diagnostics,
+    scene_diagnostics,
 };
 
 /// Number of `v` samples per condition in the exactness check (SPEC §3: ≥ 1000).
@@ -471,8 +472,8 @@ fn blend_strip_with(scene: &Scene, r0: &RenderSettings) -> Option<Result<Image, 
             let img = render_meshes(std::slice::from_ref(m), &context, &[p.color.or(Some(palette(k)))], &r);
             let mut panel = Image::new(img.width, img.height + caption_h, [255, 255, 255]);
             panel.paste(&img, 0, 0);
-            let d = patch_diagnostics(p);
-            let c = d.continuity.as_ref();
+            let c = continuity_report(p);
+            let c = c.as_ref();
             let f = |e: &str, pick: fn(&report::GapsReport) -> Option<f64>| {
                 let at = |g: Option<&report::GapsReport>| g.and_then(pick);
                 match (at(c.and_then(|c| c.start.as_ref())), at(c.and_then(|c| c.end.as_ref()))) {
