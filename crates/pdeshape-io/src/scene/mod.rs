@@ -9,13 +9,15 @@
 #![allow(clippy::result_large_err)]
 
 mod build;
+mod ctx;
 pub mod edit;
 mod error;
-mod fill;
+mod kinds;
 mod raw;
+mod sections;
 mod trim;
 
-pub use build::RESERVED;
+pub use ctx::RESERVED;
 pub use error::{SceneError, Source};
 
 use indexmap::IndexMap;

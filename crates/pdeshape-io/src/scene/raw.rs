@@ -206,6 +206,70 @@ pub struct RawPatch {
     pub end: Option<Spanned<RawEnd>>,
 }
 
+/// `RawPatch::KEYS` and `RawPatch::present_keys` from one list of the optional fields.
+macro_rules! optional_keys {
+    ($($field:ident),* $(,)?) => {
+        impl RawPatch {
+            /// Every optional key, in the order [`RawPatch::present_keys`] reports them.
+            pub const KEYS: &'static [&'static str] = &[$(stringify!($field)),*];
+
+            /// The optional keys given, in the order their checks report them (kind-specific
+            /// keys first). `kinds::check_keys` checks each against the patch's kind, so no
+            /// key is ignored.
+            pub fn present_keys(&self) -> Vec<&'static str> {
+                let given = [$(self.$field.is_some()),*];
+                Self::KEYS.iter().zip(given).filter(|g| g.1).map(|g| *g.0).collect()
+            }
+        }
+    };
+}
+
+optional_keys!(
+    a,
+    modes,
+    omega,
+    sections,
+    orders,
+    coefficients,
+    solver,
+    bubbles,
+    collocation,
+    basis,
+    start,
+    end,
+    beta,
+    gamma,
+    lambda,
+    rho,
+    eta,
+    terms,
+    joint,
+    time,
+    frames,
+    alpha,
+    trial,
+    lmn,
+    w0,
+    w0_tangent,
+    w1,
+    w1_tangent,
+    cells,
+    primary,
+    edges,
+    pole,
+    height,
+    ring,
+    corner_blend,
+    fullness,
+    order,
+    pole_curvature,
+    trim,
+    conditions,
+    resolution,
+    v,
+    color,
+);
+
 /// An edge of a fill's hole: the isoline `s` of a surface, `v` from `w[0]` to `w[1]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

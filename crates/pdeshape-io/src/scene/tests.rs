@@ -81,3 +81,41 @@ fn a_scene_carries_its_load_options() {
     assert_eq!(sc.options.limits, limits);
     assert_eq!(sc.options.solver.as_deref(), Some("collocation"));
 }
+
+/// Every key of a patch is checked against its kind's declared keys: keys a kind used to
+/// ignore without a word (`v` or `sections` on a solid or a fill) are errors naming the
+/// kinds they apply to; keys with a reason of their own keep it.
+#[test]
+fn each_kind_takes_only_its_own_keys() {
+    let solid = "[patches.q]\nkind = \"solid\"\nw0 = [\"u\", \"v\", \"0\"]\nw0_tangent = [\"0\", \"0\", \"1\"]\n\
+                 w1 = [\"u\", \"v\", \"1\"]\nw1_tangent = [\"0\", \"0\", \"1\"]\n";
+    let err = |text: &str| Scene::parse(text, "t.toml", "t", &HashMap::new()).err().map(|e| e.to_string());
+    assert!(err(solid).is_none(), "{:?}", err(solid));
+    let cases = [
+        ("v = [0, 1]\n", "patches.q.v", "`v` only applies to kind = \"hermite\", \"pde\", \"blend\" or \"dynamic\""),
+        ("modes = 3\n", "patches.q.modes", "`modes` only applies to kind = \"pde\" or \"fill\""),
+        ("orders = [2, 2, 2]\n", "patches.q.orders", "`orders` only applies to kind = \"blend\""),
+        (
+            "conditions = []\n",
+            "patches.q.conditions",
+            "a solid blend takes w0, w0_tangent, w1, w1_tangent and cells instead of `conditions`",
+        ),
+    ];
+    for (extra, key, msg) in cases {
+        let e = err(&format!("{solid}{extra}")).unwrap_or_else(|| panic!("{extra}: accepted"));
+        assert!(e.contains(key) && e.contains(msg), "{extra}: {e}");
+    }
+}
+
+/// Every optional key of a raw patch is declared by some kind (or refused by one with a
+/// reason), so the key check cannot send a valid key to "no kind".
+#[test]
+fn every_patch_key_belongs_to_a_kind() {
+    let mut declared: Vec<&str> = vec!["kind", "color"];
+    for k in &kinds::KINDS {
+        declared.extend(k.keys);
+    }
+    for name in raw::RawPatch::KEYS {
+        assert!(declared.contains(name), "`{name}` is taken by no kind");
+    }
+}

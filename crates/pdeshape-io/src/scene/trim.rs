@@ -1,7 +1,7 @@
 //! Trims in scene files: `[patches.NAME.trim]` and conditions on trim curves of earlier
 //! patches (`trim = "PATCH.CURVE"`).
 
-use super::build::{Ctx, R, span};
+use super::ctx::{Ctx, R, span};
 use super::raw::{NumOrExpr, RawTrim, RawTrimCurve};
 use super::{ScenePatch, TrimSetup};
 use pdeshape_core::data::FieldRef;

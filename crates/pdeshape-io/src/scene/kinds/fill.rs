@@ -1,16 +1,38 @@
 //! `kind = "fill"`: an N-sided hole between `[surfaces.*]` filled with exact G1 (order 4)
 //! or G2 (order 6) (`pdeshape_core::fill`).
 
-use super::build::{Ctx, R, find_surface, span};
-use super::raw::{NumOrExpr, RawPatch};
-use super::trim::find_trim_curve;
-use super::{PatchKind, ScenePatch, SceneSurface};
+use crate::scene::ctx::{Ctx, R, find_surface, span};
+use crate::scene::raw::{NumOrExpr, RawPatch};
+use crate::scene::trim::find_trim_curve;
+use crate::scene::{PatchKind, ScenePatch, SceneSurface};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::fill::{AlongCurve, DomainCurve, Fill, FillEdge, FillOptions, Host};
 use pdeshape_core::limits::Cap;
 use pdeshape_core::spectral::SpectralOptions;
 use std::sync::Arc;
 use toml::Spanned;
+
+/// The keys a `kind = "fill"` patch takes besides `kind` and `color`.
+pub(super) const KEYS: &[&str] = &[
+    "resolution",
+    "edges",
+    "pole",
+    "height",
+    "ring",
+    "corner_blend",
+    "fullness",
+    "order",
+    "pole_curvature",
+    "a",
+    "modes",
+    "omega",
+];
+
+/// Keys it refuses, with the reason.
+pub(super) const INSTEAD: &[(&str, &str)] = &[
+    ("conditions", "a fill takes `edges` instead of `conditions`"),
+    ("trim", "trims apply to hermite, pde and blend patches (not to moving, solid or fill ones)"),
+];
 
 const EDGE_FORMS: &str = "{ surface, s, w } (an isoline), { surface, curve = [s(t), v(t)], t } (a curve in the surface's domain) or { trim = \"PATCH.CURVE\", t } (an earlier patch's trim curve, t in [0, 2π])";
 
