@@ -92,16 +92,9 @@ pub enum PatchKind {
 }
 
 impl PatchKind {
-    /// The name used in scene files.
+    /// The name used in scene files (the kind's module in `scene/kinds/`).
     pub fn name(self) -> &'static str {
-        match self {
-            PatchKind::Hermite => "hermite",
-            PatchKind::Pde => "pde",
-            PatchKind::Blend => "blend",
-            PatchKind::Dynamic => "dynamic",
-            PatchKind::Solid => "solid",
-            PatchKind::Fill => "fill",
-        }
+        kinds::KINDS.iter().find(|k| k.kind == self).map_or("?", |k| k.name)
     }
 }
 

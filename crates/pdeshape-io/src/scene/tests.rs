@@ -112,10 +112,21 @@ fn each_kind_takes_only_its_own_keys() {
 #[test]
 fn every_patch_key_belongs_to_a_kind() {
     let mut declared: Vec<&str> = vec!["kind", "color"];
-    for k in &kinds::KINDS {
+    for k in kinds::KINDS {
         declared.extend(k.keys);
     }
     for name in raw::RawPatch::KEYS {
         assert!(declared.contains(name), "`{name}` is taken by no kind");
     }
+}
+
+/// A kind's name in scene files (its module's), in reports (`PatchKind`'s serialisation)
+/// and in `kind = "…"` are one: every registered kind parses under its name and reports it.
+#[test]
+fn kind_names_agree() {
+    for k in kinds::KINDS {
+        assert_eq!(k.kind.name(), k.name);
+        assert_eq!(serde_json::to_value(k.kind).unwrap(), serde_json::json!(k.name));
+    }
+    assert_eq!(kinds::KINDS.len(), 6);
 }

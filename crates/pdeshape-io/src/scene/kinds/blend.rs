@@ -1,6 +1,8 @@
 //! `kind = "blend"`: a static blend of 2nd, 4th, 6th or mixed order (SPEC §4): operators per
 //! component and the solver.
 
+use super::{PatchInput, conditions};
+use crate::scene::ScenePatch;
 use crate::scene::ctx::{Ctx, R, span};
 use crate::scene::raw::*;
 use pdeshape_core::blend::{BasisFn, BlendOptions, Operator, StaticBlend};
@@ -25,6 +27,18 @@ pub(super) const KEYS: &[&str] = &[
     "start",
     "end",
 ];
+
+/// Keys it refuses, with the reason.
+pub(super) const INSTEAD: &[(&str, &str)] = &[];
+
+/// Reads the conditions and solves the blend.
+pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
+    let c = conditions::read(input)?;
+    let setup = build_blend(input.ctx, &input.key, input.raw, &c.conditions, c.domain, c.span.clone())?;
+    let mut p = conditions::finish(input, c, setup.blend.clone())?;
+    p.blend = Some(setup);
+    Ok(p)
+}
 
 /// Operators, options and the solve of a static blend (SPEC §4).
 pub(in crate::scene) fn build_blend(

@@ -1,5 +1,7 @@
 //! `kind = "dynamic"`: a time-dependent C1 blend (SPEC §5): operator, sine terms, time range.
 
+use super::{PatchInput, conditions};
+use crate::scene::ScenePatch;
 use crate::scene::ctx::{Ctx, R, span};
 use crate::scene::raw::*;
 use pdeshape_core::blend::{DynBasis, DynamicBlend, DynamicOperator, DynamicOptions};
@@ -34,6 +36,20 @@ pub(super) const KEYS: &[&str] = &[
 /// Keys it refuses, with the reason.
 pub(super) const INSTEAD: &[(&str, &str)] =
     &[("trim", "trims apply to hermite, pde and blend patches (not to moving, solid or fill ones)")];
+
+/// Reads the conditions and sets up the blend; the patch's surface is the frame at the
+/// first time (solved now, kept for later).
+pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
+    let c = conditions::read(input)?;
+    let setup = build_dynamic(input.ctx, &input.key, input.raw, &c.conditions, c.domain, c.span.clone())?;
+    let f = setup
+        .blend
+        .frame(setup.times.0)
+        .map_err(|e| input.ctx.err(c.span.clone().or(Some(input.raw.span())), &input.key, e.to_string()))?;
+    let mut p = conditions::finish(input, c, Arc::new(f))?;
+    p.dynamic = Some(setup);
+    Ok(p)
+}
 
 /// The operator, options and basis of a dynamic blend (SPEC §5).
 pub(in crate::scene) fn build_dynamic(

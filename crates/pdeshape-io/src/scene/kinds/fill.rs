@@ -1,6 +1,7 @@
 //! `kind = "fill"`: an N-sided hole between `[surfaces.*]` filled with exact G1 (order 4)
 //! or G2 (order 6) (`pdeshape_core::fill`).
 
+use super::PatchInput;
 use crate::scene::ctx::{Ctx, R, find_surface, span};
 use crate::scene::raw::{NumOrExpr, RawPatch};
 use crate::scene::trim::find_trim_curve;
@@ -35,6 +36,11 @@ pub(super) const INSTEAD: &[(&str, &str)] = &[
 ];
 
 const EDGE_FORMS: &str = "{ surface, s, w } (an isoline), { surface, curve = [s(t), v(t)], t } (a curve in the surface's domain) or { trim = \"PATCH.CURVE\", t } (an earlier patch's trim curve, t in [0, 2π])";
+
+/// Builds the fill from its own keys.
+pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
+    build_fill(input.ctx, input.name, &input.key, input.raw, input.surfaces, input.done)
+}
 
 /// Builds a fill from its edges (isolines or curves of named surfaces, trim curves of
 /// earlier patches) and options.

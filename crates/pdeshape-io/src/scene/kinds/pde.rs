@@ -1,7 +1,10 @@
 //! `kind = "pde"`: `(∂u² + a²∂v²)^N X = 0` by the spectral method (SPEC §3), `N` from the
 //! number of conditions.
 
+use super::{PatchInput, conditions};
+use crate::scene::ScenePatch;
 use crate::scene::ctx::{Ctx, R, span};
+use std::sync::Arc;
 use crate::scene::raw::RawPatch;
 use pdeshape_core::limits::Cap;
 use pdeshape_core::patch::{Condition, VDomain};
@@ -10,6 +13,18 @@ use std::ops::Range;
 
 /// The keys a PDE patch takes besides `kind` and `color`.
 pub(super) const KEYS: &[&str] = &["v", "resolution", "conditions", "sections", "trim", "a", "modes", "omega"];
+
+/// Keys it refuses, with the reason.
+pub(super) const INSTEAD: &[(&str, &str)] = &[];
+
+/// Reads the conditions and solves the patch.
+pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
+    let c = conditions::read(input)?;
+    let sp = Arc::new(solve(input.ctx, &input.key, input.raw.get_ref(), &c.conditions, c.domain, c.span.clone())?);
+    let mut p = conditions::finish(input, c, sp.clone())?;
+    p.spectral = Some(sp);
+    Ok(p)
+}
 
 /// Solves the patch: `a` (default 1), `modes` (default 6, capped), `omega`; the order is
 /// capped too.

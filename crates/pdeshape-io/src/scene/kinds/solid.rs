@@ -1,5 +1,6 @@
 //! `kind = "solid"`: a solid blend (SPEC §6) from its four boundary surfaces.
 
+use super::PatchInput;
 use crate::scene::ctx::{Ctx, R, span};
 use crate::scene::raw::*;
 use crate::scene::{PatchKind, ScenePatch};
@@ -18,6 +19,11 @@ pub(super) const INSTEAD: &[(&str, &str)] = &[
     ("resolution", "a solid blend takes w0, w0_tangent, w1, w1_tangent and cells instead of `resolution`"),
     ("trim", "trims apply to hermite, pde and blend patches (not to moving, solid or fill ones)"),
 ];
+
+/// Builds the solid from its own keys.
+pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
+    build_solid(input.ctx, input.name, &input.key, input.raw)
+}
 
 /// A solid blend (SPEC §6) from its four boundary surfaces.
 pub(in crate::scene) fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spanned<RawPatch>) -> R<ScenePatch> {
