@@ -4,7 +4,7 @@
 
 use super::report::*;
 use super::{CHECK_SAMPLES, CONDITION_WARNING, end_data};
-use crate::scene::{BlendSetup, DynamicSetup, PatchKind, Scene, ScenePatch, SectionFamily, SolidSetup, TrimSetup};
+use crate::scene::{BlendSetup, DynamicSetup, Scene, ScenePatch, SectionFamily, SolidSetup, TrimSetup};
 use pdeshape_core::blend::{ContinuityClass, Gaps, SeamGaps, Solver, StaticBlend, attached_seam_gaps, seam_gaps};
 use pdeshape_core::data::FieldRef;
 use pdeshape_core::num::{MaxNan, max_nan};
@@ -37,7 +37,7 @@ pub fn patch_diagnostics(p: &ScenePatch) -> PatchReport {
     let mut d = PatchReport {
         name: p.name.clone(),
         kind: p.kind,
-        solver: String::new(),
+        solver: p.solver.clone(),
         conditions: p.conditions.iter().map(|c| ConditionKey::Surface { u: c.u, order: c.order }).collect(),
         v_domain: Some(VDomain { start: dom.start, end: dom.end, periodic: dom.periodic }),
         resolution: Some([p.resolution.0, p.resolution.1]),
@@ -57,18 +57,12 @@ pub fn patch_diagnostics(p: &ScenePatch) -> PatchReport {
     };
     // the condition check, once, by kind
     let rep = if let Some(b) = &p.blend {
-        d.solver = blend_solver_name(b.blend.as_ref());
         blend_condition_report(b.blend.as_ref(), &p.conditions)
     } else if let Some(dy) = &p.dynamic {
         let (rep, section) = dynamic_report(p, dy);
-        d.solver = section.solver.clone();
         d.dynamic = Some(section);
         rep
     } else {
-        d.solver = match p.kind {
-            PatchKind::Hermite => "hermite-interpolation".into(),
-            _ => "spectral".into(),
-        };
         check_conditions(p.surface.as_ref(), &p.conditions, 0.0, CHECK_SAMPLES)
     };
     d.condition_error =
@@ -163,7 +157,7 @@ fn solid_diagnostics(p: &ScenePatch, sd: &SolidSetup) -> PatchReport {
     PatchReport {
         name: p.name.clone(),
         kind: p.kind,
-        solver: rep.method.to_string(),
+        solver: p.solver.clone(),
         conditions: [(0, 0), (0, 1), (1, 0), (1, 1)].map(|(w, order)| ConditionKey::Solid { w, order }).to_vec(),
         v_domain: None,
         resolution: None,
@@ -391,16 +385,6 @@ fn spectral_report(
         rms_residual_truncated: (have_t && residuals).then(|| (t2 / n).sqrt()),
         rms_residual_remainder: residuals.then(|| (r2 / n).sqrt()),
         rms_residual_whole: (have_t && residuals).then(|| (w2 / n).sqrt()),
-    }
-}
-
-/// `"exact"`, `"collocation"` or the per-component mix.
-fn blend_solver_name(b: &StaticBlend) -> String {
-    let r = b.reports();
-    if r.iter().all(|c| c.solver == r[0].solver) {
-        r[0].solver.to_string()
-    } else {
-        format!("mixed (x: {}, y: {}, z: {})", r[0].solver, r[1].solver, r[2].solver)
     }
 }
 

@@ -109,6 +109,10 @@ pub struct ScenePatch {
     pub surface: Arc<dyn Surface>,
     /// Its conditions.
     pub conditions: Vec<Condition>,
+    /// The solve's path as reports name it (`hermite-interpolation`, `spectral`, `exact`,
+    /// `collocation`, `mixed (x: …, y: …, z: …)`, a dynamic blend's first frame's, a
+    /// solid's method), set by the kind when it solves.
+    pub solver: String,
     /// Mesh resolution `(nu, nv)` in vertices.
     pub resolution: (usize, usize),
     /// Display colour.

@@ -28,6 +28,16 @@ pub(super) const KEYS: &[&str] = &[
     "end",
 ];
 
+/// `"exact"`, `"collocation"` or the per-component mix.
+fn solver_name(b: &StaticBlend) -> String {
+    let r = b.reports();
+    if r.iter().all(|c| c.solver == r[0].solver) {
+        r[0].solver.to_string()
+    } else {
+        format!("mixed (x: {}, y: {}, z: {})", r[0].solver, r[1].solver, r[2].solver)
+    }
+}
+
 /// Keys it refuses, with the reason.
 pub(super) const INSTEAD: &[(&str, &str)] = &[];
 
@@ -35,7 +45,8 @@ pub(super) const INSTEAD: &[(&str, &str)] = &[];
 pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
     let c = conditions::read(input)?;
     let setup = build_blend(input.ctx, &input.key, input.raw, &c.conditions, c.domain, c.span.clone())?;
-    let mut p = conditions::finish(input, c, setup.blend.clone())?;
+    let solver = solver_name(&setup.blend);
+    let mut p = conditions::finish(input, c, setup.blend.clone(), solver)?;
     p.blend = Some(setup);
     Ok(p)
 }

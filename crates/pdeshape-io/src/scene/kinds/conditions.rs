@@ -133,7 +133,7 @@ pub(super) fn read(input: &PatchInput) -> R<Conditioned> {
 
 /// The patch around its solved `surface` (a trim, when given, is cut on it); the kind
 /// adds its own solved object (`spectral`, `blend`, `dynamic`).
-pub(super) fn finish(input: &PatchInput, c: Conditioned, surface: Arc<dyn Surface>) -> R<ScenePatch> {
+pub(super) fn finish(input: &PatchInput, c: Conditioned, surface: Arc<dyn Surface>, solver: String) -> R<ScenePatch> {
     let rp = input.raw.get_ref();
     let trim = rp
         .trim
@@ -145,6 +145,7 @@ pub(super) fn finish(input: &PatchInput, c: Conditioned, surface: Arc<dyn Surfac
         kind: input.kind,
         surface,
         conditions: c.conditions,
+        solver,
         resolution: c.resolution,
         color: rp.color.as_ref().map(|c| *c.get_ref()),
         spectral: None,

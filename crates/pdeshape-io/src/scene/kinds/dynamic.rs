@@ -46,7 +46,8 @@ pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
         .blend
         .frame(setup.times.0)
         .map_err(|e| input.ctx.err(c.span.clone().or(Some(input.raw.span())), &input.key, e.to_string()))?;
-    let mut p = conditions::finish(input, c, Arc::new(f))?;
+    let solver = f.report().solver.to_string();
+    let mut p = conditions::finish(input, c, Arc::new(f), solver)?;
     p.dynamic = Some(setup);
     Ok(p)
 }

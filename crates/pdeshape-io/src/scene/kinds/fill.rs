@@ -155,6 +155,7 @@ pub(super) fn build_fill(
         kind: PatchKind::Fill,
         surface: patch.clone(),
         conditions: fill.conditions().to_vec(),
+        solver: "spectral".into(),
         resolution,
         color: rp.color.as_ref().map(|c| *c.get_ref()),
         spectral: Some(patch),

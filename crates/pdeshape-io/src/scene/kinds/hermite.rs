@@ -17,5 +17,5 @@ pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
     let c = conditions::read(input)?;
     let h = HermitePatch::new(&c.conditions, c.domain)
         .map_err(|e| input.ctx.err(c.span.clone(), format!("{}.conditions", input.key), e.to_string()))?;
-    conditions::finish(input, c, Arc::new(h))
+    conditions::finish(input, c, Arc::new(h), "hermite-interpolation".into())
 }

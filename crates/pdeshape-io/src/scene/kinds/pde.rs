@@ -21,7 +21,7 @@ pub(super) const INSTEAD: &[(&str, &str)] = &[];
 pub(super) fn build(input: &PatchInput) -> R<ScenePatch> {
     let c = conditions::read(input)?;
     let sp = Arc::new(solve(input.ctx, &input.key, input.raw.get_ref(), &c.conditions, c.domain, c.span.clone())?);
-    let mut p = conditions::finish(input, c, sp.clone())?;
+    let mut p = conditions::finish(input, c, sp.clone(), "spectral".into())?;
     p.spectral = Some(sp);
     Ok(p)
 }

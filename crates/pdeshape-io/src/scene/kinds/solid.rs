@@ -111,6 +111,7 @@ pub(in crate::scene) fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spann
         kind: PatchKind::Solid,
         surface,
         conditions: vec![],
+        solver: blend.report().method.to_string(),
         resolution: (cells.0, cells.1),
         color: rp.color.as_ref().map(|c| *c.get_ref()),
         spectral: None,
