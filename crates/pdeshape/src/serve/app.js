@@ -1,7 +1,9 @@
 // pdeshape editor: WebGL2 view (shading, zebra, isophotes, curvature maps, seams), parameter
 // sliders, handles, trim editor, diagnostics.
-// State exposed for tests as window.pdeshape.
-"use strict";
+// State exposed for tests as window.pdeshape. An ES module (strict); the wire format is
+// read by wire.js.
+import * as wire from "/wire.js";
+
 const S = window.pdeshape = {
   frames: 0, vertexCount: 0, meshHash: "", lastError: null, diagnostics: null,
   lastDownload: null, requests: 0, header: null,
@@ -119,8 +121,8 @@ void main() { gl_Position = proj * view * vec4(pos, 1.0); gl_Position.z -= 0.001
 precision highp float; in vec3 vc; out vec4 o; void main() { o = vec4(vc, 1.0); }`);
 
 function upload(header, bytes) {
-  const f32 = (r) => new Float32Array(bytes, r.offset, r.count);
-  const u32 = (r) => new Uint32Array(bytes, r.offset, r.count);
+  const f32 = (r) => wire.f32(bytes, r);
+  const u32 = (r) => wire.u32(bytes, r);
   const patches = header.patches.map((p) => {
     const vao = gl.createVertexArray(); gl.bindVertexArray(vao);
     const buf = (data, loc, size) => {
@@ -478,10 +480,7 @@ async function solve(diagnostics) {
       showError(e.error);   // the edit is kept in the editor and shown as invalid, the model is not replaced
     } else {
       backoff = 0;
-      const bytes = await r.arrayBuffer();
-      const n = new DataView(bytes).getUint32(0, true);
-      const header = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 4, n)));
-      const data = bytes.slice(4 + n);
+      const { header, data } = wire.decode(await r.arrayBuffer());
       const first = !model;
       if (edits === sent) { scene.text = header.text; edits = []; }
       model = { header, patches: upload(header, data) };

@@ -20,6 +20,8 @@
 //! from the request's arrival, queueing included, and a solve past it is cancelled (the
 //! solvers' checkpoints unwind it) and holds its slot until it has really stopped.
 
+mod wire;
+
 use crate::EXAMPLES;
 use anyhow::{Context, Result};
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State};
@@ -54,6 +56,7 @@ pub const MAX_QUEUED: usize = 8;
 
 const PAGE: &str = include_str!("page.html");
 const APP: &str = include_str!("app.js");
+const WIRE_JS: &str = include_str!("wire.js");
 
 /// Options of `pdeshape serve`.
 pub struct ServeOptions {
@@ -274,6 +277,7 @@ pub fn router(
     Router::new()
         .route("/", get(|| async { Html(PAGE) }))
         .route("/app.js", get(|| async { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], APP) }))
+        .route("/wire.js", get(|| async { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], WIRE_JS) }))
         .route("/api/initial", get(initial_scene))
         .route("/api/examples", get(|| async { Json(EXAMPLES.iter().map(|(n, _)| *n).collect::<Vec<_>>()) }))
         .route("/api/example/{name}", get(example))
@@ -459,7 +463,16 @@ async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelReques
         let (scene, text, meshes) = solve(&req, &limits)?;
         let curves = req.curves.as_ref().map(|c| curves_json(&scene, c));
         let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
-        Ok(encode(&solved, req.diagnostics, curves))
+        Ok(wire::encode(
+            &wire::Model {
+                scene: &solved.scene,
+                text: &solved.text,
+                meshes: &solved.meshes,
+                solve_ms: solved.solve_ms,
+            },
+            req.diagnostics,
+            curves,
+        ))
     })
     .await;
     match r {
@@ -521,120 +534,4 @@ async fn export_route(
             .into_response(),
         Err(resp) => resp,
     }
-}
-
-/// The binary answer: `u32` header length, JSON header (padded to 4 bytes), buffers.
-fn encode(s: &Solved, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
-    let mut buf: Vec<u8> = Vec::new();
-    let put_f32 = |buf: &mut Vec<u8>, xs: &mut dyn Iterator<Item = f32>| -> Value {
-        let offset = buf.len();
-        let mut n = 0;
-        for x in xs {
-            buf.extend_from_slice(&x.to_le_bytes());
-            n += 1;
-        }
-        json!({"offset": offset, "count": n})
-    };
-    let mut patches = Vec::new();
-    for (m, p) in s.meshes.iter().zip(&s.scene.patches) {
-        let positions = put_f32(&mut buf, &mut m.positions.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]));
-        let normals = put_f32(&mut buf, &mut m.normals.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]));
-        let tris = m.all_triangles();
-        let offset = buf.len();
-        for t in &tris {
-            for i in t {
-                buf.extend_from_slice(&i.to_le_bytes());
-            }
-        }
-        let indices = json!({"offset": offset, "count": tris.len() * 3});
-        // wireframe: quad edges (and triangle edges)
-        let offset = buf.len();
-        let mut n = 0;
-        for q in &m.quads {
-            for k in 0..4 {
-                buf.extend_from_slice(&q[k].to_le_bytes());
-                buf.extend_from_slice(&q[(k + 1) % 4].to_le_bytes());
-                n += 2;
-            }
-        }
-        for t in &m.triangles {
-            for k in 0..3 {
-                buf.extend_from_slice(&t[k].to_le_bytes());
-                buf.extend_from_slice(&t[(k + 1) % 3].to_le_bytes());
-                n += 2;
-            }
-        }
-        let lines = json!({"offset": offset, "count": n});
-        let curves: Vec<Value> = m
-            .curves
-            .iter()
-            .map(|c| put_f32(&mut buf, &mut c.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])))
-            .collect();
-        let fields: Vec<Value> = m
-            .fields
-            .iter()
-            .map(|f| {
-                let mut v = put_f32(&mut buf, &mut f.values.iter().map(|x| *x as f32));
-                v["name"] = json!(f.name);
-                v
-            })
-            .collect();
-        let trim = p.trim.as_ref().map(|t| {
-            let g = &t.grid;
-            let ring0: Vec<[f64; 2]> = (0..=g.columns).map(|j| g.points[g.index(0, j)]).collect();
-            let step = (g.columns / 48).max(1);
-            let spokes: Vec<Vec<[f64; 2]>> =
-                (0..g.columns).step_by(step).map(|j| (0..g.rings).map(|i| g.points[g.index(i, j)]).collect()).collect();
-            let rings: Vec<Vec<[f64; 2]>> = (0..g.rings)
-                .step_by((g.rings / 12).max(1))
-                .map(|i| (0..=g.columns).map(|j| g.points[g.index(i, j)]).collect())
-                .collect();
-            let dom = p.surface.v_domain();
-            json!({"domain": [[0.0, dom.start], [1.0, dom.end]], "loop": ring0, "spokes": spokes, "rings": rings,
-                   "folds_before": g.report.folds_before, "folds_after": g.report.folds_after})
-        });
-        patches.push(json!({
-            "name": m.name,
-            "kind": p.kind.name(),
-            "color": p.color,
-            "vertices": m.positions.len(),
-            "grid": m.grid,
-            "seams": model::seam_ends(p),
-            "positions": positions, "normals": normals, "indices": indices, "lines": lines,
-            "curves": curves, "fields": fields, "trim": trim,
-        }));
-    }
-    let params: Vec<Value> = s
-        .scene
-        .params
-        .iter()
-        .map(|(k, p)| {
-            json!({"name": k, "value": p.value, "min": p.min, "max": p.max, "step": p.step,
-                             "derived": p.expr.is_some(), "description": p.description})
-        })
-        .collect();
-    let time = s.scene.patches.iter().find_map(|p| p.dynamic.as_ref()).map(|d| json!([d.times.0, d.times.1]));
-    let header = json!({
-        "name": s.scene.name,
-        "title": s.scene.title,
-        "text": s.text,
-        "params": params,
-        "time_range": time,
-        "view": {"azimuth": s.scene.render.azimuth, "elevation": s.scene.render.elevation},
-        "patches": patches,
-        "editables": edit::editables(&s.text),
-        "hash": model::mesh_hash(&s.meshes),
-        "solve_ms": s.solve_ms,
-        "diagnostics": diagnostics.then(|| model::scene_diagnostics(&s.scene)),
-        "curves": curves,
-    });
-    let mut h = serde_json::to_vec(&header).expect("JSON of plain values");
-    while !h.len().is_multiple_of(4) {
-        h.push(b' ');
-    }
-    let mut out = Vec::with_capacity(4 + h.len() + buf.len());
-    out.extend_from_slice(&(h.len() as u32).to_le_bytes());
-    out.extend_from_slice(&h);
-    out.extend_from_slice(&buf);
-    out
 }

@@ -1,0 +1,16 @@
+// The editor's wire format (serve/wire.rs), the answer of POST /api/model: a little-endian
+// u32 header length, the JSON header (padded to 4 bytes), then the buffers the header's
+// { offset, count } slices point into (little-endian f32 and u32).
+
+// The header and the buffers of an answer.
+export function decode(bytes) {
+  const n = new DataView(bytes).getUint32(0, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 4, n)));
+  return { header, data: bytes.slice(4 + n) };
+}
+
+// A slice of f32 values (positions, normals, curves, fields).
+export const f32 = (data, slice) => new Float32Array(data, slice.offset, slice.count);
+
+// A slice of u32 values (triangle and line indices).
+export const u32 = (data, slice) => new Uint32Array(data, slice.offset, slice.count);

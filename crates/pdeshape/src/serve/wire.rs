@@ -1,0 +1,236 @@
+//! The editor's wire format, the answer of `POST /api/model`: a little-endian `u32`, the
+//! length of the JSON [`Header`] that follows (padded with spaces to a multiple of 4
+//! bytes), then the buffers the header points into as [`Slice`]s — little-endian `f32`
+//! positions, normals, curves and fields, `u32` triangle and line indices. `wire.js` is the
+//! reading side.
+
+use pdeshape_core::mesh::Mesh;
+use pdeshape_io::model;
+use pdeshape_io::model::report::SceneReport;
+use pdeshape_io::scene::{PatchKind, Scene, ScenePatch, edit};
+use serde::Serialize;
+use serde_json::Value;
+
+/// What is sent: a solved scene, its (edited) text and meshes.
+pub struct Model<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its text after the request's edits.
+    pub text: &'a str,
+    /// One mesh per patch.
+    pub meshes: &'a [Mesh],
+    /// Time spent solving and meshing (ms).
+    pub solve_ms: f64,
+}
+
+/// `count` values from byte `offset` of the buffers.
+#[derive(Serialize)]
+pub struct Slice {
+    offset: usize,
+    count: usize,
+}
+
+/// A per-vertex field.
+#[derive(Serialize)]
+struct FieldSlice {
+    offset: usize,
+    count: usize,
+    name: String,
+}
+
+/// The header.
+#[derive(Serialize)]
+struct Header<'a> {
+    name: &'a str,
+    title: Option<&'a str>,
+    text: &'a str,
+    params: Vec<Param<'a>>,
+    /// A dynamic blend's `[t0, t1]`.
+    time_range: Option<[f64; 2]>,
+    view: View,
+    patches: Vec<Patch<'a>>,
+    /// The text's draggable handles and editable trims (`scene::edit`).
+    editables: Value,
+    /// `model::mesh_hash` of the meshes (tests compare it).
+    hash: String,
+    solve_ms: f64,
+    /// `check`'s report, when asked for.
+    diagnostics: Option<SceneReport>,
+    /// The curve tools' answer, when asked for.
+    curves: Option<Value>,
+}
+
+/// A slider.
+#[derive(Serialize)]
+struct Param<'a> {
+    name: &'a str,
+    value: f64,
+    min: Option<f64>,
+    max: Option<f64>,
+    step: Option<f64>,
+    /// Defined by an expression of other parameters (not a slider).
+    derived: bool,
+    description: Option<&'a str>,
+}
+
+/// The initial camera.
+#[derive(Serialize)]
+struct View {
+    azimuth: f64,
+    elevation: f64,
+}
+
+/// One patch's mesh.
+#[derive(Serialize)]
+struct Patch<'a> {
+    name: &'a str,
+    kind: PatchKind,
+    color: Option<[f64; 3]>,
+    vertices: usize,
+    grid: Option<(usize, usize)>,
+    /// The `u` of the patch's seams (continuity colouring).
+    seams: Vec<f64>,
+    positions: Slice,
+    normals: Slice,
+    indices: Slice,
+    /// Pairs of vertex indices: quad and triangle edges.
+    lines: Slice,
+    curves: Vec<Slice>,
+    fields: Vec<FieldSlice>,
+    trim: Option<Trim>,
+}
+
+/// A trimmed patch's grid in its parameter domain, thinned for the trim editor.
+#[derive(Serialize)]
+struct Trim {
+    domain: [[f64; 2]; 2],
+    #[serde(rename = "loop")]
+    outline: Vec<[f64; 2]>,
+    spokes: Vec<Vec<[f64; 2]>>,
+    rings: Vec<Vec<[f64; 2]>>,
+    folds_before: usize,
+    folds_after: usize,
+}
+
+/// The buffers being written.
+struct Buffers(Vec<u8>);
+
+impl Buffers {
+    fn f32s(&mut self, xs: impl Iterator<Item = f32>) -> Slice {
+        let offset = self.0.len();
+        let mut count = 0;
+        for x in xs {
+            self.0.extend_from_slice(&x.to_le_bytes());
+            count += 1;
+        }
+        Slice { offset, count }
+    }
+
+    fn u32s(&mut self, xs: impl Iterator<Item = u32>) -> Slice {
+        let offset = self.0.len();
+        let mut count = 0;
+        for x in xs {
+            self.0.extend_from_slice(&x.to_le_bytes());
+            count += 1;
+        }
+        Slice { offset, count }
+    }
+
+    fn points<'p>(&mut self, ps: impl Iterator<Item = &'p pdeshape_core::Vec3>) -> Slice {
+        self.f32s(ps.flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]))
+    }
+}
+
+fn trim(p: &ScenePatch) -> Option<Trim> {
+    let t = p.trim.as_ref()?;
+    let g = &t.grid;
+    let step = (g.columns / 48).max(1);
+    let dom = p.surface.v_domain();
+    Some(Trim {
+        domain: [[0.0, dom.start], [1.0, dom.end]],
+        outline: (0..=g.columns).map(|j| g.points[g.index(0, j)]).collect(),
+        spokes: (0..g.columns).step_by(step).map(|j| (0..g.rings).map(|i| g.points[g.index(i, j)]).collect()).collect(),
+        rings: (0..g.rings)
+            .step_by((g.rings / 12).max(1))
+            .map(|i| (0..=g.columns).map(|j| g.points[g.index(i, j)]).collect())
+            .collect(),
+        folds_before: g.report.folds_before,
+        folds_after: g.report.folds_after,
+    })
+}
+
+/// The answer's bytes; `diagnostics`: compute and include the report.
+pub fn encode(s: &Model, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
+    let mut buf = Buffers(Vec::new());
+    let mut patches = Vec::new();
+    for (m, p) in s.meshes.iter().zip(&s.scene.patches) {
+        let positions = buf.points(m.positions.iter());
+        let normals = buf.points(m.normals.iter());
+        let indices = buf.u32s(m.all_triangles().into_iter().flatten());
+        // wireframe: quad edges (and triangle edges)
+        let quad_edges = m.quads.iter().flat_map(|q| (0..4).flat_map(move |k| [q[k], q[(k + 1) % 4]]));
+        let tri_edges = m.triangles.iter().flat_map(|t| (0..3).flat_map(move |k| [t[k], t[(k + 1) % 3]]));
+        let lines = buf.u32s(quad_edges.chain(tri_edges));
+        let curves = m.curves.iter().map(|c| buf.points(c.iter())).collect();
+        let fields = m
+            .fields
+            .iter()
+            .map(|f| {
+                let Slice { offset, count } = buf.f32s(f.values.iter().map(|x| *x as f32));
+                FieldSlice { offset, count, name: f.name.clone() }
+            })
+            .collect();
+        patches.push(Patch {
+            name: &m.name,
+            kind: p.kind,
+            color: p.color,
+            vertices: m.positions.len(),
+            grid: m.grid,
+            seams: model::seam_ends(p),
+            positions,
+            normals,
+            indices,
+            lines,
+            curves,
+            fields,
+            trim: trim(p),
+        });
+    }
+    let header = Header {
+        name: &s.scene.name,
+        title: s.scene.title.as_deref(),
+        text: s.text,
+        params: s
+            .scene
+            .params
+            .iter()
+            .map(|(k, p)| Param {
+                name: k,
+                value: p.value,
+                min: p.min,
+                max: p.max,
+                step: p.step,
+                derived: p.expr.is_some(),
+                description: p.description.as_deref(),
+            })
+            .collect(),
+        time_range: s.scene.patches.iter().find_map(|p| p.dynamic.as_ref()).map(|d| [d.times.0, d.times.1]),
+        view: View { azimuth: s.scene.render.azimuth, elevation: s.scene.render.elevation },
+        patches,
+        editables: edit::editables(s.text),
+        hash: model::mesh_hash(s.meshes),
+        solve_ms: s.solve_ms,
+        diagnostics: diagnostics.then(|| model::scene_diagnostics(s.scene)),
+        curves,
+    };
+    // Plain structs of numbers and strings always serialise.
+    let mut h = serde_json::to_vec(&header).unwrap_or_default();
+    while !h.len().is_multiple_of(4) {
+        h.push(b' ');
+    }
+    let mut out = Vec::with_capacity(4 + h.len() + buf.0.len());
+    out.extend_from_slice(&(h.len() as u32).to_le_bytes());
+    out.extend_from_slice(&h);
+    out.extend_from_slice(&buf.0);
+    out
+}
