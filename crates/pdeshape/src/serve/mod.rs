@@ -55,8 +55,13 @@ pub const SOLVE_LIMIT: Duration = Duration::from_secs(30);
 pub const MAX_QUEUED: usize = 8;
 
 const PAGE: &str = include_str!("page.html");
-const APP: &str = include_str!("app.js");
-const WIRE_JS: &str = include_str!("wire.js");
+/// The editor's ES modules, by path: `app.js` imports the others.
+const SCRIPTS: [(&str, &str); 4] = [
+    ("/app.js", include_str!("app.js")),
+    ("/wire.js", include_str!("wire.js")),
+    ("/camera.js", include_str!("camera.js")),
+    ("/views.js", include_str!("views.js")),
+];
 
 /// Options of `pdeshape serve`.
 pub struct ServeOptions {
@@ -274,10 +279,14 @@ pub fn router(
         time_limit,
         threads,
     });
-    Router::new()
-        .route("/", get(|| async { Html(PAGE) }))
-        .route("/app.js", get(|| async { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], APP) }))
-        .route("/wire.js", get(|| async { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], WIRE_JS) }))
+    let mut router = Router::new().route("/", get(|| async { Html(PAGE) }));
+    for (path, body) in SCRIPTS {
+        router = router.route(
+            path,
+            get(move || async move { ([(header::CONTENT_TYPE, "text/javascript; charset=utf-8")], body) }),
+        );
+    }
+    router
         .route("/api/initial", get(initial_scene))
         .route("/api/examples", get(|| async { Json(EXAMPLES.iter().map(|(n, _)| *n).collect::<Vec<_>>()) }))
         .route("/api/example/{name}", get(example))
