@@ -25,6 +25,7 @@ pub mod fit;
 pub mod jet;
 pub mod limits;
 pub mod linalg;
+pub mod memo;
 pub mod mesh;
 pub mod num;
 pub mod ode;

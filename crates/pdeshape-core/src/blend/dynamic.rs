@@ -6,14 +6,14 @@ use crate::data::FieldRef;
 use crate::expr::{Expr, expand};
 use crate::jet::{Jet, JetShape};
 use crate::linalg::{least_squares, least_squares_min_norm};
+use crate::memo::BoundedMemo;
 use crate::num::MaxNan;
 use crate::ode::{Cardinal, CondSpec, ExpSpace};
 use crate::patch::{Condition, Surface, VDomain, cubic_hermite};
 use faer::Mat;
-use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
 
 /// `β∂u⁴ + γ∂u²∂v² + λ∂v⁴ + ρ∂t² + η∂t`: the dynamic blend operator with its five shape
 /// parameters (paper 002 eq. 3, without the force term).
@@ -287,7 +287,7 @@ pub struct DynamicBlend {
     /// Frames solved so far, by the bits of `t`: every caller (mesh, animation, reports,
     /// exporters) asks [`frame`](Self::frame) and each instant is solved once. Shared by
     /// clones, which are the same blend.
-    frames: Arc<Mutex<HashMap<u64, DynamicFrame>>>,
+    frames: Arc<BoundedMemo<u64, DynamicFrame>>,
     /// How many frames were solved (not served from `frames`).
     solves: Arc<AtomicUsize>,
 }
@@ -460,7 +460,7 @@ impl DynamicBlend {
             eigen,
             exact,
             opts: opts.clone(),
-            frames: Default::default(),
+            frames: Arc::new(BoundedMemo::new(1024)),
             solves: Default::default(),
         })
     }
@@ -479,19 +479,12 @@ impl DynamicBlend {
     /// solver is in use), solved once per instant: later calls for the same `t` return
     /// the frame already solved.
     pub fn frame(&self, t: f64) -> Result<DynamicFrame, BlendError> {
-        if let Some(f) = self.frames.lock().ok().and_then(|m| m.get(&t.to_bits()).cloned()) {
-            return Ok(f);
-        }
-        let f = self.solve_frame(t)?;
-        self.solves.fetch_add(1, Ordering::Relaxed);
-        if let Ok(mut m) = self.frames.lock() {
-            // bounded: a long animation or a scan of t does not grow it without end
-            if m.len() >= 1024 {
-                m.clear();
-            }
-            m.insert(t.to_bits(), f.clone());
-        }
-        Ok(f)
+        // bounded: a long animation or a scan of t does not grow it without end
+        self.frames.get_or_try_insert_with(t.to_bits(), || {
+            let f = self.solve_frame(t)?;
+            self.solves.fetch_add(1, Ordering::Relaxed);
+            Ok(f)
+        })
     }
 
     /// How many frames this blend (and its clones) has solved; instants asked for again

@@ -26,14 +26,14 @@
 use crate::Vec3;
 use crate::data::fourier::{FourierSeries, sample_count};
 use crate::data::{EvenExtension, FieldRef};
+use crate::memo::BoundedMemo;
 use crate::num::MaxNan;
 use crate::ode::{CardinalSet, CondSpec, ExpSpace, OdeError};
 use crate::patch::{Condition, Surface, VDomain};
 use faer::Mat;
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::f64::consts::PI;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
 /// Options of the spectral solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,7 +96,7 @@ pub struct SpectralPatch {
     deep_kmax: usize,
     deep: OnceLock<Option<CardSets>>,
     time: f64,
-    cache: Mutex<HashMap<(u64, usize), Arc<Row>>>,
+    cache: BoundedMemo<(u64, usize), Arc<Row>>,
 }
 
 /// The modes' cardinal sets and the remainder's.
@@ -144,7 +144,8 @@ fn describe(conds: &[CondSpec]) -> String {
 
 /// `(rate bits, n, condition positions and orders, kmax)`.
 type MemoKey = (u64, usize, Vec<(u64, usize)>, usize);
-static CARDINAL_MEMO: std::sync::OnceLock<Mutex<HashMap<MemoKey, Arc<CardinalSet>>>> = std::sync::OnceLock::new();
+static CARDINAL_MEMO: std::sync::LazyLock<BoundedMemo<MemoKey, Arc<CardinalSet>>> =
+    std::sync::LazyLock::new(|| BoundedMemo::new(256));
 
 /// Cardinal functions of `ExpSpace::symmetric(rate, n)` for the condition set, memoised
 /// process-wide: they depend only on the operator and the condition positions, not on the
@@ -152,24 +153,14 @@ static CARDINAL_MEMO: std::sync::OnceLock<Mutex<HashMap<MemoKey, Arc<CardinalSet
 /// parameter) reuses them. Bounded: the memo is emptied when it holds 256 sets.
 fn cardinal_set(rate: f64, n: usize, specs: &[CondSpec], kmax: usize) -> Result<Arc<CardinalSet>, OdeError> {
     let key: MemoKey = (rate.to_bits(), n, specs.iter().map(|c| (c.u.to_bits(), c.order)).collect(), kmax);
-    let memo = CARDINAL_MEMO.get_or_init(Default::default);
-    if let Some(c) = memo.lock().ok().and_then(|m| m.get(&key).cloned()) {
-        return Ok(c);
-    }
-    let c = Arc::new(CardinalSet::new(ExpSpace::symmetric(rate, n), specs, kmax)?);
-    if let Ok(mut m) = memo.lock() {
-        if m.len() >= 256 {
-            m.clear();
-        }
-        m.insert(key, c.clone());
-    }
-    Ok(c)
+    CARDINAL_MEMO
+        .get_or_try_insert_with(key, || Ok(Arc::new(CardinalSet::new(ExpSpace::symmetric(rate, n), specs, kmax)?)))
 }
 
 /// Empties the process-wide memo of cardinal functions, so that the next solves compute
 /// them anew (benchmarks of cold solves use it; results do not change).
 pub fn clear_cardinal_memo() {
-    CARDINAL_MEMO.get_or_init(Default::default).lock().map(|mut m| m.clear()).unwrap_or(())
+    CARDINAL_MEMO.clear()
 }
 
 impl SpectralPatch {
@@ -253,7 +244,7 @@ impl SpectralPatch {
             deep_kmax: if n <= 10 { 2 * n } else { 0 },
             deep: OnceLock::new(),
             time: 0.0,
-            cache: Mutex::new(HashMap::new()),
+            cache: BoundedMemo::new(4096),
         })
     }
 
@@ -290,9 +281,7 @@ impl SpectralPatch {
 
     /// Drops the per-row cache (rows are recomputed on the next evaluation).
     pub fn clear_row_cache(&self) {
-        if let Ok(mut c) = self.cache.lock() {
-            c.clear();
-        }
+        self.cache.clear();
     }
 
     fn theta(&self, v: f64) -> f64 {
@@ -322,7 +311,7 @@ impl SpectralPatch {
 
     fn row(&self, u: f64, k: usize) -> Arc<Row> {
         let key = (u.to_bits(), k);
-        if let Some(r) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+        if let Some(r) = self.cache.get(&key) {
             return r;
         }
         let m = self.opts.modes;
@@ -339,12 +328,7 @@ impl SpectralPatch {
             }
         }
         let row = Arc::new(Row { a, b, l: rem.eval(u, k) });
-        if let Ok(mut c) = self.cache.lock() {
-            if c.len() > 4096 {
-                c.clear();
-            }
-            c.insert(key, row.clone());
-        }
+        self.cache.insert(key, row.clone());
         row
     }
 
