@@ -5,7 +5,6 @@ use anyhow::{Result, anyhow};
 use pdeshape_bench::tables::{self, AccuracyRow, Table1Row, TrimTableRow};
 use pdeshape_core::limits::Limits;
 use pdeshape_io::scene::Scene;
-use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -14,6 +13,23 @@ fn example(name: &str, limits: Limits) -> Result<Scene> {
         EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))?;
     let opts = pdeshape_io::scene::LoadOptions { limits, ..Default::default() };
     Ok(Scene::parse_with(text, &format!("examples/{name}.toml"), name, &opts)?)
+}
+
+/// `bench --json`: the papers' tables as measured here.
+#[derive(serde::Serialize)]
+struct Tables<'a> {
+    machine: String,
+    threads: usize,
+    paper_002_table_1: &'a [Table1Row],
+    paper_002_accuracy: &'a [AccuracyRow],
+    paper_003_table_1: &'a [TrimTableRow],
+}
+
+/// `scaling.json`: the scaling study's rows.
+#[derive(serde::Serialize)]
+struct Scaling<'a> {
+    machine: String,
+    rows: &'a [pdeshape_bench::scaling::ScalingRow],
 }
 
 /// Runs every table; prints Markdown (or JSON) and optionally writes both next to `out`.
@@ -28,13 +44,13 @@ pub fn run(runs: usize, json_out: bool, out: Option<&Path>, limits: Limits) -> R
     let t3 = tables::on_one_thread(|| tables::trim_table1(&trim_scene, runs.max(5)))
         .map_err(|e| anyhow!(e))?
         .map_err(|e| anyhow!(e))?;
-    let doc = json!({
-        "machine": machine(),
-        "threads": 1,
-        "paper_002_table_1": t1,
-        "paper_002_accuracy": acc,
-        "paper_003_table_1": t3,
-    });
+    let doc = Tables {
+        machine: machine(),
+        threads: 1,
+        paper_002_table_1: &t1,
+        paper_002_accuracy: &acc,
+        paper_003_table_1: &t3,
+    };
     let mut md = markdown(&t1, &acc, runs);
     md.push_str(&trim_markdown(&t3, runs.max(5)));
     if json_out {
@@ -66,7 +82,7 @@ pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool, limits: Li
     .map_err(|e| anyhow!(e))?;
     std::fs::create_dir_all(dir)?;
     let md = format!("# Scaling study\n\nMachine: {}\n{}", machine(), scaling::markdown(&rows));
-    let doc = json!({ "machine": machine(), "rows": rows });
+    let doc = Scaling { machine: machine(), rows: &rows };
     pdeshape_io::export::write_atomic(&dir.join("scaling.md"), |w| w.write_all(md.as_bytes()))?;
     pdeshape_io::export::write_atomic(&dir.join("scaling.json"), |w| {
         w.write_all(serde_json::to_string_pretty(&doc)?.as_bytes())

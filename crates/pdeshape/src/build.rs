@@ -1,11 +1,116 @@
-//! The build step shared by `build DIR` and the gallery: a scene's outputs written into a
-//! directory, all or nothing.
+//! `pdeshape build`: a scene's condition check, then its outputs — one mesh file, a STEP
+//! file, a picture, or a directory of everything (the build step the gallery shares), all
+//! or nothing.
 
-use anyhow::{Context, Result, anyhow};
+use crate::check::{cad_lines, check_finite_report, continuity_line, not_finite};
+use anyhow::{Context, Result, anyhow, bail};
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// `--tolerance`, `--relative-tolerance` and `--degree` (STEP output only).
+#[derive(Clone, Copy, Debug)]
+pub struct StepOptions {
+    /// Certified deviation (absolute).
+    pub tolerance: Option<f64>,
+    /// Certified deviation relative to each face's size.
+    pub relative_tolerance: Option<f64>,
+    /// B-spline degree.
+    pub degree: Option<usize>,
+}
+
+/// Runs `build` on a loaded scene: the output's kind comes from `out`'s extension (none: a
+/// directory).
+pub fn command(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Result<()> {
+    let StepOptions { tolerance, relative_tolerance, degree } = *step;
+    // the condition check runs before anything is written: a scene that fails it
+    // leaves no file (quiet: the check alone; otherwise the whole report, printed below)
+    let diagnostics = if quiet {
+        for p in &sc.patches {
+            let r = model::condition_report(p);
+            if !(r.max_abs.is_finite() && r.max_rel.is_finite()) {
+                bail!(not_finite(&p.name));
+            }
+        }
+        None
+    } else {
+        let d = model::scene_diagnostics(sc);
+        check_finite_report(&d)?;
+        Some(d)
+    };
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if (tolerance.is_some() || relative_tolerance.is_some() || degree.is_some()) && ext != "step" && ext != "stp" {
+        bail!("--tolerance, --relative-tolerance and --degree apply to STEP output only (-o FILE.step)");
+    }
+    if ext == "step" || ext == "stp" {
+        if sc.patches.is_empty() {
+            bail!("the scene {} has no patches to write", sc.file);
+        }
+        let o = pdeshape_io::cad::CadOptions {
+            tolerance,
+            relative: relative_tolerance.unwrap_or(1e-6),
+            degree: degree.unwrap_or(3),
+            time: None,
+        };
+        let fitted = pdeshape_io::cad::fit_scene(sc, &o).map_err(|e| anyhow!(e))?;
+        pdeshape_io::cad::write_scene_step(out, sc, &fitted)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        if !quiet {
+            for line in cad_lines(&fitted) {
+                eprintln!("{line}");
+            }
+            eprintln!("wrote {} ({} face{})", out.display(), fitted.len(), if fitted.len() == 1 { "" } else { "s" });
+        }
+    } else if ext == "png" {
+        let img = model::render_scene(sc).map_err(|e| anyhow!(e))?;
+        write_png(out, &img)?;
+        if !quiet {
+            eprintln!("wrote {}", out.display());
+        }
+    } else if let Some(fmt) = Format::from_extension(&ext) {
+        let meshes = model::patch_meshes(sc).map_err(|e| anyhow!(e))?;
+        let refs: Vec<_> = meshes.iter().collect();
+        write_meshes(out, fmt, &refs).with_context(|| format!("cannot write {}", out.display()))?;
+        if !quiet {
+            let nv: usize = meshes.iter().map(|m| m.positions.len()).sum();
+            eprintln!(
+                "wrote {} ({} patch{}, {nv} vertices)",
+                out.display(),
+                meshes.len(),
+                if meshes.len() == 1 { "" } else { "es" }
+            );
+        }
+    } else if !ext.is_empty() {
+        bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, step, png, or a directory)");
+    } else {
+        let files = build_into_dir(sc, out)?;
+        if !quiet {
+            for f in files {
+                eprintln!("wrote {}", f.display());
+            }
+        }
+    }
+    if !quiet {
+        for d in diagnostics.iter().flat_map(|d| &d.patches) {
+            eprintln!(
+                "patch {}: {} ({}), max condition error {:.2e} (relative)",
+                d.name,
+                d.kind.name(),
+                d.solver,
+                d.condition_error.max_rel
+            );
+            if let Some(line) = continuity_line(d) {
+                eprintln!("  {line}");
+            }
+        }
+    }
+    Ok(())
+}
+
+pub fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
+    write_atomic(path, |w| img.write_png(w)).with_context(|| format!("cannot write {}", path.display()))
+}
 
 /// Writes the scene's outputs into a directory: one file per patch and format, plus
 /// `NAME.png` for the picture. Returns the files written.

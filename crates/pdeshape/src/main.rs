@@ -3,8 +3,11 @@
 
 mod bench;
 mod build;
+mod check;
 mod cli;
+mod clip;
 mod gallery;
+mod sample;
 mod serve;
 
 include!(concat!(env!("OUT_DIR"), "/examples.rs"));

@@ -162,22 +162,23 @@ impl CurvesRequest {
     }
 }
 
-/// The requested curves of every patch as JSON: per patch `{section: [[x, y, z, kx, ky, kz,
-/// x′, y′, z′, k′…]…], combs: [{u, points: [x, y, z…], curvature: [kx, ky, kz…]}…]}`
-/// (curvature vectors point to the centre of curvature; NaN becomes null where undefined).
-fn curves_json(scene: &Scene, c: &CurvesRequest) -> Value {
+/// The requested curves of every patch: per patch its plane section (segments `[x, y, z,
+/// kx, ky, kz, x′, y′, z′, k′…]`) and combs (`u`, points, curvature vectors, which point to
+/// the centre of curvature; NaN becomes null where undefined). Trimmed, solid and moving
+/// patches get none.
+fn curves_answer(scene: &Scene, c: &CurvesRequest) -> Vec<wire::PatchCurves> {
     use pdeshape_core::patch::{CurvePoint, iso_u_curve, plane_section};
     let flat = |pts: &[CurvePoint]| -> (Vec<f64>, Vec<f64>) {
         let p = pts.iter().flat_map(|c| [c.point.x, c.point.y, c.point.z]).collect();
         let k = pts.iter().flat_map(|c| [c.curvature.x, c.curvature.y, c.curvature.z]).collect();
         (p, k)
     };
-    let patches: Vec<Value> = scene
+    scene
         .patches
         .iter()
         .map(|p| {
             if p.trim.is_some() || p.solid.is_some() || p.dynamic.is_some() {
-                return json!({"name": p.name});
+                return wire::PatchCurves::None { name: p.name.clone() };
             }
             let s = p.surface.as_ref();
             let (nu, nv) = p.resolution;
@@ -204,17 +205,16 @@ fn curves_json(scene: &Scene, c: &CurvesRequest) -> Value {
             let n = (4 * nv).clamp(64, 1024);
             let dom = s.v_domain();
             let cvs: Vec<f64> = (0..=n).map(|k| dom.at(k as f64 / n as f64)).collect();
-            let combs: Vec<Value> = comb_us
+            let combs = comb_us
                 .iter()
                 .map(|&u| {
                     let (points, curvature) = flat(&iso_u_curve(s, u, &cvs));
-                    json!({"u": u, "points": points, "curvature": curvature})
+                    wire::Comb { u, points, curvature }
                 })
                 .collect();
-            json!({"name": p.name, "section": section, "combs": combs})
+            wire::PatchCurves::Some { name: p.name.clone(), section, combs }
         })
-        .collect();
-    Value::Array(patches)
+        .collect()
 }
 
 /// Runs the server until interrupted; prints the URL.
@@ -470,7 +470,7 @@ async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelReques
             c.check()?;
         }
         let (scene, text, meshes) = solve(&req, &limits)?;
-        let curves = req.curves.as_ref().map(|c| curves_json(&scene, c));
+        let curves = req.curves.as_ref().map(|c| curves_answer(&scene, c));
         let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
         Ok(wire::encode(
             &wire::Model {

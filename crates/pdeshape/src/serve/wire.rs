@@ -57,7 +57,38 @@ struct Header<'a> {
     /// `check`'s report, when asked for.
     diagnostics: Option<SceneReport>,
     /// The curve tools' answer, when asked for.
-    curves: Option<Value>,
+    curves: Option<Vec<PatchCurves>>,
+}
+
+/// One patch's curves for the curve tools.
+#[derive(Serialize)]
+#[serde(untagged)]
+pub enum PatchCurves {
+    /// Curves of this patch are not drawn (trimmed, solid and moving patches).
+    None {
+        /// The patch.
+        name: String,
+    },
+    /// Its plane section and combs.
+    Some {
+        /// The patch.
+        name: String,
+        /// Segments `[x, y, z, kx, ky, kz, x′, y′, z′, k′…]`, when a section was asked for.
+        section: Option<Vec<Vec<f64>>>,
+        /// Combs along lines `u`.
+        combs: Vec<Comb>,
+    },
+}
+
+/// A curvature comb along the line `u`: points and curvature vectors, flattened.
+#[derive(Serialize)]
+pub struct Comb {
+    /// The line.
+    pub u: f64,
+    /// `[x, y, z, …]`.
+    pub points: Vec<f64>,
+    /// `[kx, ky, kz, …]`.
+    pub curvature: Vec<f64>,
 }
 
 /// A slider.
@@ -160,7 +191,7 @@ fn trim(p: &ScenePatch) -> Option<Trim> {
 }
 
 /// The answer's bytes; `diagnostics`: compute and include the report.
-pub fn encode(s: &Model, diagnostics: bool, curves: Option<Value>) -> Vec<u8> {
+pub fn encode(s: &Model, diagnostics: bool, curves: Option<Vec<PatchCurves>>) -> Vec<u8> {
     let mut buf = Buffers(Vec::new());
     let mut patches = Vec::new();
     for (m, p) in s.meshes.iter().zip(&s.scene.patches) {

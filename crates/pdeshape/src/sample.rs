@@ -1,0 +1,113 @@
+//! `pdeshape sample`: exact points of a patch (or a solid) at the parameters read from
+//! stdin as CSV (`u,v` or `u,v,w`), written as CSV.
+
+use crate::clip::clip;
+use anyhow::{Context, Result, anyhow, bail};
+use pdeshape_io::scene::Scene;
+use std::io::{BufRead, Write};
+
+/// Runs `sample` on a loaded scene: the named patch (or the first), at time `time`.
+pub fn command(sc: &Scene, patch: Option<&str>, time: Option<f64>, quiet: bool) -> Result<()> {
+    let p = match patch {
+        Some(n) => sc.patch(n).ok_or_else(|| {
+            anyhow!(
+                "no patch named `{}` in {} (patches: {})",
+                clip(n, 60),
+                sc.file,
+                sc.patches.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
+            )
+        })?,
+        None => sc.patches.first().ok_or_else(|| anyhow!("the scene {} has no patches", sc.file))?,
+    };
+    if let Some(t) = time
+        && t != 0.0
+        && p.dynamic.is_none()
+        && !quiet
+    {
+        eprintln!("note: patch `{}` is not a dynamic blend: --time does not change it", p.name);
+    }
+    match (&p.dynamic, time, &p.solid) {
+        (_, _, Some(sd)) => sample_solid(&sd.blend),
+        (Some(d), Some(t), _) => {
+            let f = d.blend.frame(t).map_err(|e| anyhow!("patch `{}` at t = {t}: {e}", p.name))?;
+            sample(&f)
+        }
+        _ => sample(p.surface.as_ref()),
+    }
+}
+
+/// Reads CSV rows of `N` finite numbers from stdin and writes `header` then one line per
+/// row from `f`; errors name the line. Blank lines and `#` comments are skipped, and so is
+/// a first line that is literally the column names (`u,v` or `u,v,w`, spaces allowed); a
+/// UTF-8 byte-order mark is dropped. Any other line that is not `N` numbers is an error.
+fn sample_rows<const N: usize>(
+    header: &str,
+    mut f: impl FnMut(usize, [f64; N], &mut dyn Write) -> Result<()>,
+) -> Result<()> {
+    let names = header.split(',').take(N).collect::<Vec<_>>().join(",");
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    writeln!(out, "{header}")?;
+    let mut first = true;
+    for (ln, line) in stdin.lock().lines().enumerate() {
+        let line = line.with_context(|| format!("cannot read stdin line {}", ln + 1))?;
+        let l = if ln == 0 { line.trim_start_matches('\u{feff}') } else { &line }.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
+        if std::mem::take(&mut first) && cols.join(",") == names {
+            continue; // the header
+        }
+        if cols.len() != N {
+            bail!("stdin line {}: expected {N} columns `{names}`, got {}: {:?}", ln + 1, cols.len(), clip(l, 80));
+        }
+        let mut vals = [0.0f64; N];
+        for (k, c) in cols.iter().enumerate() {
+            vals[k] = c.parse().map_err(|_| anyhow!("stdin line {}: `{}` is not a number", ln + 1, clip(c, 40)))?;
+            if !vals[k].is_finite() {
+                bail!("stdin line {}: `{c}` is not finite", ln + 1);
+            }
+        }
+        f(ln + 1, vals, &mut out)?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// `u,v,w` from stdin to `u,v,w,x,y,z` for a solid blend.
+fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
+    sample_rows("u,v,w,x,y,z", |ln, [u, v, w], out| {
+        for (name, x) in [("u", u), ("v", v), ("w", w)] {
+            if !(0.0..=1.0).contains(&x) {
+                bail!("stdin line {ln}: {name} = {x} is outside [0, 1]");
+            }
+        }
+        let x = s.point(u, v, w);
+        if !x.is_finite() {
+            bail!("stdin line {ln}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})");
+        }
+        writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+        Ok(())
+    })
+}
+
+/// `u,v` from stdin to `u,v,x,y,z` for a patch.
+fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {
+    let dom = surface.v_domain();
+    sample_rows("u,v,x,y,z", |ln, [u, v], out| {
+        if !(0.0..=1.0).contains(&u) {
+            bail!("stdin line {ln}: u = {u} is outside [0, 1]");
+        }
+        if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
+            bail!("stdin line {ln}: v = {v} is outside [{}, {}]", dom.start, dom.end);
+        }
+        let x = surface.point(u, v);
+        if !x.is_finite() {
+            bail!("stdin line {ln}: the patch is not finite at (u, v) = ({u}, {v})");
+        }
+        writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
+        Ok(())
+    })
+}
