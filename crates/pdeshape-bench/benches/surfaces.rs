@@ -215,7 +215,7 @@ fn evaluate_million(c: &mut Criterion) {
     g.finish();
 }
 
-/// Issue 18: certified B-spline fitting of a scene's faces (solved patches given; the fit
+/// Issue 18: measured B-spline fitting of a scene's faces (solved patches given; the fit
 /// keeps nothing between iterations), at the default tolerance (1e-6 × each face's
 /// bounding-box diagonal) and at 1e-8 ×.
 fn cad_fit(c: &mut Criterion) {
@@ -223,7 +223,7 @@ fn cad_fit(c: &mut Criterion) {
     g.sample_size(10);
     for name in ["dolphin", "bloor-wilson-blend", "fill-sphere-pentagon"] {
         let sc = load(&format!("{name}.toml"));
-        g.bench_function(format!("{name}: every face at 1e-6 (certified)"), |b| {
+        g.bench_function(format!("{name}: every face at 1e-6 (measured maximum)"), |b| {
             b.iter(|| pdeshape_io::cad::fit_scene(&sc, &Default::default()).unwrap())
         });
     }

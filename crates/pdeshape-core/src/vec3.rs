@@ -62,6 +62,27 @@ impl Vec3 {
         self.dot(self).sqrt()
     }
 
+    /// Euclidean length without underflow or overflow on the way: the components are
+    /// scaled by the largest before squaring, so `|a|` is right (to round-off) for any
+    /// finite `a`, from subnormal to `f64::MAX`, where [`norm`](Self::norm) squares to 0 below
+    /// ~1e-154 and to inf above ~1e154. NaN propagates; slower than `norm`.
+    ///
+    /// ```
+    /// use pdeshape_core::Vec3;
+    /// assert_eq!(Vec3::new(3e-200, 4e-200, 0.0).norm(), 0.0);
+    /// assert!((Vec3::new(3e-200, 4e-200, 0.0).scaled_norm() / 5e-200 - 1.0).abs() < 1e-15);
+    /// assert!((Vec3::new(3e200, 4e200, 0.0).scaled_norm() / 5e200 - 1.0).abs() < 1e-15);
+    /// assert!(Vec3::new(f64::NAN, 1.0, 0.0).scaled_norm().is_nan());
+    /// ```
+    #[inline]
+    pub fn scaled_norm(self) -> f64 {
+        let m = self.max_abs();
+        if m == 0.0 || !m.is_finite() {
+            return m;
+        }
+        m * (self / m).norm()
+    }
+
     /// Largest absolute component (the ∞-norm); NaN when a component is NaN.
     #[inline]
     pub fn max_abs(self) -> f64 {

@@ -1,4 +1,4 @@
-"""pdeshape's certified B-spline fit beside OpenCASCADE's GeomAPI_PointsToBSplineSurface on
+"""pdeshape's measured B-spline fit beside OpenCASCADE's GeomAPI_PointsToBSplineSurface on
 the same number of samples (BENCHMARKS.md, issue 18).
 
 For each face: pdeshape's fit at the default tolerance (1e-6 × the face's bounding-box
@@ -6,7 +6,7 @@ diagonal) gives a net of nu × nv control points; OCCT approximates a uniform nu
 of exact points (`pdeshape sample`) with Tol3D = the same tolerance (degree 3 … 8, C2).
 Both surfaces are then measured against 4000 random exact points by projection
 (GeomAPI_ProjectPointOnSurf): the largest distance found. OCCT guarantees its tolerance at
-its samples only; pdeshape's figure is certified everywhere.
+its samples only; pdeshape's figure is the measured maximum over every knot cell.
 
     python crates/pdeshape-io/bench/occt_fit.py   # needs cadquery-ocp and target/release/pdeshape
 """
@@ -32,7 +32,7 @@ from OCP.gp import gp_Pnt
 ROOT = Path(__file__).resolve().parents[3]
 BIN = str(ROOT / "target/release/pdeshape")
 CASES = [("bloor-wilson-blend", "blend"), ("four-curve-patch", "sheet"), ("dolphin", "body"), ("fill-sphere-pentagon", "cap")]
-REPORT = re.compile(r"face (\S+): B-spline (\d+) × (\d+) control points, certified deviation (\S+) ≤ (\S+)")
+REPORT = re.compile(r"face (\S+): B-spline (\d+) × (\d+) control points, measured deviation (\S+) ≤ (\S+)")
 
 
 def sample(scene, patch, uv):
@@ -98,7 +98,7 @@ def main():
                     out.stat().st_size,
                 )
             )
-    print("| face | tolerance | pdeshape net | certified max | max at 4000 random points | OCCT net | OCCT time (ms) | OCCT max at 4000 random points | STEP bytes |")
+    print("| face | tolerance | pdeshape net | measured max | max at 4000 random points | OCCT net | OCCT time (ms) | OCCT max at 4000 random points | STEP bytes |")
     print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r[0]} | {r[1]:.2e} | {r[2]} | {r[3]:.2e} | {r[4]:.2e} | {r[5]} | {r[6]:.1f} | {r[7]:.2e} | {r[8]} |")

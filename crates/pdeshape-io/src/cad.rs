@@ -1,5 +1,5 @@
 //! A scene as CAD geometry: every patch, and the drawn part of every primary surface,
-//! fitted by a certified B-spline surface (`pdeshape_core::fit`) and written as STEP; the
+//! fitted by a measured B-spline surface (`pdeshape_core::fit`) and written as STEP; the
 //! seams between the fitted faces measured after the fit.
 
 use crate::export::{StepFace, StepHole, write_atomic, write_step};
@@ -13,13 +13,13 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// One face: a patch or a primary surface's drawn part as a B-spline surface with its
-/// certificate.
+/// measured maximum deviation.
 pub struct CadFace {
     /// The patch's name, or `surface-NAME` for a primary surface.
     pub name: String,
     /// The fitted surface.
     pub surface: BSplineSurface,
-    /// What the fit achieved (certified maximum deviation, control points).
+    /// What the fit achieved (measured maximum deviation, control points).
     pub report: FitReport,
     /// A primary surface's drawn part (not a patch).
     pub primary: bool,
@@ -36,7 +36,7 @@ pub struct Hole {
     /// `S(C(t))`, `t ∈ [0, 2π]`, fitted to the face's tolerance — or the boundary
     /// isocurve of the face standing on the hole ([`Hole::root_of`]).
     pub curve: pdeshape_core::fit::BSplineCurve3,
-    /// Its certified deviation from the exact `S(C(t))`.
+    /// Its measured deviation from the exact `S(C(t))`.
     pub deviation: f64,
     /// `C(t)` in the face's `(u, v)` as a planar spline (`z = 0`), the edge's pcurve.
     pub pcurve: pdeshape_core::fit::BSplineCurve3,
@@ -66,7 +66,7 @@ pub struct Seam {
 /// How a scene becomes CAD faces.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CadOptions {
-    /// The certified maximum deviation of every face (absolute); `None`: `relative` ×
+    /// The measured maximum deviation of every face (absolute); `None`: `relative` ×
     /// each face's bounding-box diagonal.
     pub tolerance: Option<f64>,
     /// The tolerance relative to each face's bounding-box diagonal (default 1e-6).
@@ -170,6 +170,10 @@ pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
             ..Default::default()
         };
         let (surface, report) = fit_surface(j.surface.as_ref(), &fo).map_err(|e| format!("{}: {e}", j.label))?;
+        if !report.max_deviation.is_finite() {
+            return Err(format!("{}: the measured deviation {} is not finite", j.label, report.max_deviation));
+        }
+        crate::export::check_uncertainty(&j.name, &surface, report.tolerance)?;
         Ok(CadFace {
             name: j.name.clone(),
             surface,
@@ -303,7 +307,7 @@ pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
 /// boundary isocurve runs along a hole's curve at the same parameter (`v = t`, within the
 /// two tolerances at 17 probes), the hole takes that isocurve — control points and knots —
 /// as its curve, so that the STEP writer writes one edge for both and they are one shell.
-/// The isocurve lies within the standing face's certified deviation of the exact curve, and
+/// The isocurve lies within the standing face's measured deviation of the exact curve, and
 /// so within the sum of both tolerances of the trimmed face.
 fn share_roots(out: &mut [CadFace]) {
     for b in 0..out.len() {
@@ -339,11 +343,19 @@ fn share_roots(out: &mut [CadFace]) {
 }
 
 /// The unit normal `S_u × S_v` of a fitted face, or NaN where it degenerates.
-fn normal(b: &BSplineSurface, u: f64, v: f64) -> (Vec3, Vec3) {
+///
+/// The normal is `None` at a pole — where the isocurve `u = const` is one point (`|S_v|` at
+/// most 1e-12 of `|S_u|`), so no normal is defined and the seam's angle leaves the point
+/// out. A normal that vanishes or is not finite anywhere else is NaN, and the seam's
+/// angle becomes NaN with it.
+fn normal(b: &BSplineSurface, u: f64, v: f64) -> (Vec3, Option<Vec3>) {
     let d = b.derivatives(u, v, 1, 1);
+    if d[1].max_abs() <= 1e-12 * d[2].max_abs() {
+        return (d[0], None);
+    }
     let n = d[2].cross(d[1]);
     let len = n.norm();
-    (d[0], if len > 0.0 { n * (1.0 / len) } else { Vec3::new(f64::NAN, f64::NAN, f64::NAN) })
+    (d[0], Some(if len > 0.0 { n * (1.0 / len) } else { Vec3::new(f64::NAN, f64::NAN, f64::NAN) }))
 }
 
 /// The normal curvature of a fitted face at `(u, v)` in the tangent direction normal to
@@ -392,7 +404,7 @@ pub fn seams(faces: &[CadFace], n: usize) -> Vec<Seam> {
                         let v = v0 + (v1 - v0) * k as f64 / (n - 1).max(1) as f64;
                         let ((pa, na), (pb, nb)) = (normal(fa, ua, v), normal(fb, ub, v));
                         gap = max_nan(gap, (pa - pb).norm());
-                        if na.is_finite() && nb.is_finite() {
+                        if let (Some(na), Some(nb)) = (na, nb) {
                             // normal lines: the faces may be oriented either way
                             angle = max_nan(angle, na.cross(nb).norm().min(1.0).asin());
                             let (ka, kb) = (cross_curvature(fa, ua, v, na), cross_curvature(fb, ub, v, na));
@@ -439,10 +451,10 @@ pub struct CadFaceReport {
     pub primary: bool,
     /// Control points `[nu, nv]`.
     pub control_points: [usize; 2],
-    /// The tolerance the fit was certified against.
+    /// The tolerance the fit was held to.
     pub tolerance: f64,
-    /// The certified maximum deviation.
-    pub certified_deviation: f64,
+    /// The measured maximum deviation.
+    pub measured_deviation: f64,
     /// The face's holes.
     pub holes: Vec<CadHoleReport>,
 }
@@ -454,8 +466,8 @@ pub struct CadHoleReport {
     pub name: String,
     /// Control points of its space curve.
     pub control_points: usize,
-    /// Its certified deviation from the exact curve on the face.
-    pub certified_deviation: f64,
+    /// Its measured deviation from the exact curve on the face.
+    pub measured_deviation: f64,
 }
 
 /// One seam between fitted faces.
@@ -486,14 +498,14 @@ impl CadReport {
                 primary: f.primary,
                 control_points: [f.report.points.0, f.report.points.1],
                 tolerance: f.report.tolerance,
-                certified_deviation: f.report.max_deviation,
+                measured_deviation: f.report.max_deviation,
                 holes: f
                     .holes
                     .iter()
                     .map(|h| CadHoleReport {
                         name: h.name.clone(),
                         control_points: h.curve.control.len(),
-                        certified_deviation: h.deviation,
+                        measured_deviation: h.deviation,
                     })
                     .collect(),
             })
@@ -540,7 +552,7 @@ fn step_faces(faces: &[CadFace]) -> Vec<StepFace<'_>> {
 }
 
 fn uncertainty(faces: &[CadFace]) -> f64 {
-    faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, f64::min)
+    faces.iter().map(|p| p.report.tolerance).fold(f64::INFINITY, pdeshape_core::num::min_nan)
 }
 
 /// Writes `faces` to `path` as one STEP product named after the scene (atomically); the

@@ -7,7 +7,20 @@ use pdeshape_io::scene::Scene;
 use std::io::{BufRead, Write};
 
 /// Runs `sample` on a loaded scene: the named patch (or the first), at time `time`.
+/// `surface-NAME` (the name of a primary surface's face in a STEP export) samples the drawn
+/// part of the primary surface NAME in that face's parameters: `u ∈ [0, 1]` across its
+/// `s_range`, `v` its own.
 pub fn command(sc: &Scene, patch: Option<&str>, time: Option<f64>, quiet: bool) -> Result<()> {
+    if let Some(name) = patch.and_then(|n| n.strip_prefix("surface-"))
+        && sc.patch(patch.unwrap_or_default()).is_none()
+        && let Some(s) = sc.surfaces.iter().find(|s| s.name == name)
+    {
+        let range = s.s_range.ok_or_else(|| {
+            anyhow!("surface `{}` has no s_range: it is not drawn, so it has no face to sample", clip(name, 60))
+        })?;
+        let ps = pdeshape_core::patch::PrimarySurface::new(s.field.clone(), range, s.domain, time.unwrap_or(0.0));
+        return sample(&ps);
+    }
     let p = match patch {
         Some(n) => sc.patch(n).ok_or_else(|| {
             anyhow!(

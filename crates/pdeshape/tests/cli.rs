@@ -239,3 +239,41 @@ fn bench_keeps_the_limits_it_is_given() {
     assert!(err.contains("over the `order` cap of 2") && !err.contains("panicked"), "{err}");
     assert!(o.stdout.is_empty(), "no table printed");
 }
+
+/// `sample --patch surface-NAME` evaluates the drawn part of a primary surface in the
+/// parameters of its STEP face (`u` across `s_range`): hermite-blend's cylinder
+/// `(r cos v, r sin v, s)` with `s = z0 + 1.5 u`, written out here.
+#[test]
+fn sample_evaluates_a_primary_surfaces_face() {
+    let (r, z0) = (1.0f64, 1.5f64);
+    let out = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["sample", "--patch", "surface-cylinder"])
+        .arg(example("hermite-blend.toml"))
+        .write_stdin("u,v\n0,0\n0.5,1\n1,2.5\n")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 3);
+    for c in rows {
+        let (u, v) = (c[0], c[1]);
+        let want = [r * v.cos(), r * v.sin(), z0 + 1.5 * u];
+        for (g, w) in c[2..].iter().zip(want) {
+            // the expression evaluator's round-off on values of size ~3
+            assert!((g - w).abs() <= 1e-15 * 4.0, "({u}, {v}): {g} vs {w}");
+        }
+    }
+    // a surface that is not drawn (no s_range) or does not exist is named
+    let o = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["sample", "--patch", "surface-nope"])
+        .arg(example("hermite-blend.toml"))
+        .write_stdin("u,v\n0,0\n")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("surface-nope"));
+}

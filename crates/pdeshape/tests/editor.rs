@@ -160,7 +160,7 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
     assert!(d.as_str().unwrap().contains("o sheet"), "{d}");
     let bytes = js(&c, "return window.pdeshape.lastDownload.bytes").await;
     assert!(bytes.as_u64().unwrap() > 10_000, "{bytes}");
-    // and the model as CAD geometry: certified B-spline faces in STEP
+    // and the model as CAD geometry: measured B-spline faces in STEP
     c.find(Locator::Css("button[data-format=step]")).await.unwrap().click().await.unwrap();
     let d = wait_for(
         &c,

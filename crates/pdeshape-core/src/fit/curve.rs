@@ -1,10 +1,10 @@
-//! Certified B-spline approximation of space curves (trim edges in 3D).
+//! B-spline approximation of space curves (trim edges in 3D).
 //!
 //! `c(t)`, `t ∈ [t₀, t₁]`, is interpolated at the Greville abscissae of a clamped knot
 //! vector of degree 3 (full multiplicity at the given corner parameters, where `c` is only
 //! C0). The deviation `|S(t) − c(t)|` is sampled at 16 points per span and maximised
 //! around the largest samples of each span by golden-section search; spans above the
-//! tolerance are halved until the certified maximum is within it.
+//! tolerance are halved until the measured maximum is within it.
 
 use super::{FitError, Knots, interpolate};
 use crate::Vec3;
@@ -27,11 +27,11 @@ impl BSplineCurve3 {
     }
 }
 
-/// Samples per span for the certificate.
+/// Samples per span for the measured maximum.
 const SAMPLES: usize = 16;
 
 /// Fits `c` on `[t0, t1]` with C0 corners at `corners` to the absolute tolerance `tol`;
-/// returns the curve and its certified maximum deviation.
+/// returns the curve and its measured maximum deviation.
 pub fn fit_curve(
     c: &dyn Fn(f64) -> Vec3,
     t0: f64,
@@ -134,7 +134,7 @@ pub fn fit_curve(
 mod tests {
     use super::*;
 
-    /// A helix to 1e-9, certified; a square (C0 corners) reproduced by its corner knots.
+    /// A helix to 1e-9 (measured); a square (C0 corners) reproduced by its corner knots.
     #[test]
     fn a_helix_and_a_square() {
         let helix = |t: f64| Vec3::new(t.cos(), t.sin(), 0.3 * t);

@@ -1,4 +1,4 @@
-//! Certified tensor-product B-spline approximation of exact surfaces (for CAD exchange).
+//! Tensor-product B-spline approximation of exact surfaces to a measured maximum deviation (for CAD exchange).
 //!
 //! A patch `X(u, v)` (any [`Surface`]: exact derivatives) is approximated by a clamped
 //! B-spline surface `S(u, v) = Σᵢⱼ Nᵢ(u) Mⱼ(v) Pᵢⱼ` of degree 3 (or 5) on the patch's own
@@ -12,10 +12,11 @@
 //!   The patch's boundary rows are interpolated at their Greville points too, so corners
 //!   are exact and a periodic `v` closes (positions equal at the seam; the seam's tangent
 //!   continuity is within the tolerance).
-//! - **Certificate**: the parametric deviation `|S(u, v) − X(u, v)|` bounds the distance of
+//! - **Measured maximum** (not a proved bound): the parametric deviation `|S(u, v) − X(u, v)|` bounds the distance of
 //!   every point of `S` from the patch. It is sampled on a 7 × 7 grid in every knot-span
 //!   cell, and from every discrete local maximum of those samples it is maximised locally (projected gradient ascent with exact derivatives of `S` and `X`).
-//!   The reported maximum is the largest value found.
+//!   The reported maximum is the largest value found; a bump narrower than the
+//!   sample spacing can lie between the samples and be missed.
 //! - **Refinement**: every knot span in `u` (and in `v`) that holds a cell above the
 //!   tolerance is halved, and the fit is repeated, until the maximum is within the
 //!   tolerance or the control net would exceed `max_points` per direction (an error).
@@ -144,7 +145,7 @@ impl Default for FitOptions {
 pub struct FitReport {
     /// The tolerance aimed at (absolute).
     pub tolerance: f64,
-    /// The certified maximum parametric deviation (absolute).
+    /// The measured maximum parametric deviation (absolute).
     pub max_deviation: f64,
     /// Where it was found.
     pub at: (f64, f64),
@@ -152,7 +153,7 @@ pub struct FitReport {
     pub points: (usize, usize),
     /// Fit–check–refine rounds.
     pub rounds: usize,
-    /// Samples and local maximisations the certificate took.
+    /// Samples and local maximisations the measurement took.
     pub samples: usize,
 }
 
@@ -178,6 +179,13 @@ pub enum FitError {
         /// The cap.
         cap: usize,
     },
+    /// The patch is a single point: there is no face to fit.
+    #[error("the patch is a single point (its bounding box has no extent): there is no face to fit")]
+    Degenerate,
+    /// The tolerance is not a positive finite number (given so, or the patch's size
+    /// times the relative tolerance is not).
+    #[error("the tolerance {0:e} is not a positive finite number")]
+    BadTolerance(f64),
     /// A collocation matrix could not be factorised.
     #[error("the interpolation system is singular: {0}")]
     Singular(String),
@@ -297,7 +305,7 @@ fn spline_grid(b: &BSplineSurface, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
 /// maximised locally until no remaining peak could overtake the largest maximum found,
 /// were it to gain three times as much over its sample as any ascent so far (plus 10 %). (The error of
 /// a spline fit to a smooth patch is a low-degree bump per cell, sampled at sevenths of a
-/// span: ascents gain a few per cent. This is where the certificate trusts the sampling;
+/// span: ascents gain a few per cent. This is where the measurement trusts the sampling (no bound is proved);
 /// the tests check it against dense random points.) While some sample is above `tol` the
 /// fit is refined anyway and the local search is skipped.
 fn cell_deviations(s: &dyn Surface, b: &BSplineSurface, tol: f64) -> (Vec<(f64, f64, f64)>, usize) {
@@ -330,7 +338,7 @@ fn cell_deviations(s: &dyn Surface, b: &BSplineSurface, tol: f64) -> (Vec<(f64, 
             .collect();
         let exact = s.grid(&us, &vs);
         let spline = spline_grid(b, &us, &vs);
-        let d: Vec<f64> = exact.iter().zip(&spline).map(|(x, y)| (x[0] - *y).norm()).collect();
+        let d: Vec<f64> = exact.iter().zip(&spline).map(|(x, y)| (x[0] - *y).scaled_norm()).collect();
         for chunk in d.chunks(K * nvs) {
             dev.push(chunk.to_vec());
         }
@@ -406,8 +414,9 @@ fn cell_deviations(s: &dyn Surface, b: &BSplineSurface, tol: f64) -> (Vec<(f64, 
     (out, evals)
 }
 
-/// Projected gradient ascent of `|S − X|²` within a cell from `(u, v)`, with exact
-/// derivatives; step halved until the value grows.
+/// Projected gradient ascent of `|S − X|` within a cell from `(u, v)`, with exact
+/// derivatives; step halved until the value grows. Lengths are scaled norms, so a patch
+/// at 1e-160 or 1e160 is measured as one at 1 (no square underflows or overflows).
 fn local_max(
     s: &dyn Surface,
     b: &BSplineSurface,
@@ -416,19 +425,28 @@ fn local_max(
     ru: (f64, f64),
     rv: (f64, f64),
 ) -> (f64, f64, f64, usize) {
-    let f = |u: f64, v: f64| {
-        let e = b.point(u, v) - s.point(u, v);
-        e.dot(e)
-    };
+    let f = |u: f64, v: f64| (b.point(u, v) - s.point(u, v)).scaled_norm();
     let (mut u, mut v) = (u0, v0);
     let mut fv = f(u, v);
     let mut step = 0.25 * (ru.1 - ru.0).max(rv.1 - rv.0);
     let mut evals = 1;
     for _ in 0..30 {
         let (ds, dx) = (b.derivatives(u, v, 1, 1), s.derivatives(u, v, 1, 1));
+        // the gradient of |e| is ê·e_u, ê·e_v (ê the unit error); index a·2 + b: [S, S_v, S_u, S_uv]
         let e = ds[0] - dx[0];
-        // index a·2 + b: [S, S_v, S_u, S_uv]
-        let (gu, gv) = (2.0 * e.dot(ds[2] - dx[2]), 2.0 * e.dot(ds[1] - dx[1]));
+        let n = e.scaled_norm();
+        if !(n > 0.0 && n.is_finite()) {
+            break;
+        }
+        let e = e / n;
+        let (gu, gv) = (e.dot(ds[2] - dx[2]), e.dot(ds[1] - dx[1]));
+        // only the gradient's direction is used: scaled to its largest component so that
+        // its square neither underflows (a patch at 1e-160) nor overflows (at 1e160)
+        let m = crate::num::max_nan(gu.abs(), gv.abs());
+        if !(m > 0.0 && m.is_finite()) {
+            break;
+        }
+        let (gu, gv) = (gu / m, gv / m);
         let g = (gu * gu * (ru.1 - ru.0).powi(2) + gv * gv * (rv.1 - rv.0).powi(2)).sqrt();
         if g.is_nan() || g == 0.0 {
             break;
@@ -440,8 +458,9 @@ fn local_max(
             let fnew = f(nu, nv);
             evals += 1;
             if fnew > fv {
-                // converged when the square grows by less than 1e-9 of itself
-                moved = fnew - fv > 1e-9 * fnew;
+                // converged when the deviation grows by less than 5e-10 of itself (its
+                // square by less than 1e-9)
+                moved = fnew - fv > 5e-10 * fnew;
                 (u, v, fv) = (nu, nv, fnew);
                 step *= 1.5;
                 break;
@@ -452,7 +471,7 @@ fn local_max(
             break;
         }
     }
-    (fv.sqrt(), u, v, evals)
+    (fv, u, v, evals)
 }
 
 /// Knots of degree `p` on `[a, b]` with the distinct interior breakpoints `interior`;
@@ -599,7 +618,7 @@ fn refine(b: &[f64], split: &[bool]) -> Vec<f64> {
 
 /// Fits `s` on its parameter rectangle (`u ∈ [0, 1]`, `v` its domain) to the tolerance.
 ///
-/// Each round fits, certifies, and then for every cell above the tolerance: searches its
+/// Each round fits, measures the deviation, and then for every cell above the tolerance: searches its
 /// spans for a C0 line of the patch once they are half the first spans or less
 /// ([`find_kink`]; a found line gets a knot of full multiplicity), and halves the spans in
 /// the directions whose error estimate ([`direction_weight`]) is at least a quarter of
@@ -617,9 +636,16 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
                     (lo, hi) = (lo.min(p), hi.max(p));
                 }
             }
-            o.relative * (hi - lo).norm()
+            let size = (hi - lo).scaled_norm();
+            if size == 0.0 {
+                return Err(FitError::Degenerate);
+            }
+            o.relative * size
         }
     };
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(FitError::BadTolerance(tol));
+    }
     let p = o.degree;
     let mut axes = [Axis::new(0.0, 1.0, o.spans.0, &[]), Axis::new(dom.start, dom.end, o.spans.1, &o.v_breaks)];
     for (ax, start) in axes.iter_mut().zip([&o.u_start, &o.v_start]) {

@@ -28,11 +28,11 @@ fn a_paraboloid_is_reproduced_exactly() {
     }
 }
 
-/// The unit sphere (poles at u = 0 and 1, periodic v): the certified maximum is within the
-/// tolerance, and at 4000 random points — none of them a certificate sample — the deviation
-/// is at most the certified maximum. Corners and the seam are exact.
+/// The unit sphere (poles at u = 0 and 1, periodic v): the measured maximum is within the
+/// tolerance, and at 4000 random points — none of them a sample of the fit — the deviation
+/// is at most the measured maximum. Corners and the seam are exact.
 #[test]
-fn the_sphere_is_fitted_within_the_certified_tolerance() {
+fn the_sphere_is_fitted_within_the_tolerance() {
     let s = Sphere(1.0);
     for tol in [1e-4, 1e-6, 1e-8] {
         let (b, r) = fit_surface(&s, &FitOptions { tolerance: Some(tol), ..Default::default() }).unwrap();
@@ -43,13 +43,17 @@ fn the_sphere_is_fitted_within_the_certified_tolerance() {
             worst = crate::num::max_nan(worst, (b.point(u, v) - s.point(u, v)).norm());
         }
         eprintln!(
-            "sphere at {tol:e}: {:?} control points, certified {:.2e}, random {:.2e}, {} rounds",
+            "sphere at {tol:e}: {:?} control points, measured {:.2e}, random {:.2e}, {} rounds",
             r.points, r.max_deviation, worst, r.rounds
         );
         assert!(worst <= tol, "random points: {worst} > {tol}");
-        // a random point lies on some bump the certificate ascended to its top (to a step
+        // a random point lies on some bump the measurement ascended to its top (to a step
         // of 1e-6 of the cell, so ~1e-12 relative in value)
-        assert!(worst <= r.max_deviation * (1.0 + 1e-9), "random {worst} above the certificate {}", r.max_deviation);
+        assert!(
+            worst <= r.max_deviation * (1.0 + 1e-9),
+            "random {worst} above the measured maximum {}",
+            r.max_deviation
+        );
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (0.0, tau), (1.0, tau), (0.5, 0.0)] {
             assert!((b.point(u, v) - s.point(u, v)).norm() < 1e-14, "({u}, {v})");
         }
@@ -72,7 +76,7 @@ fn an_unreachable_tolerance_is_an_error() {
 /// (not a knot of any uniform net) is found by the kink search and gets a knot of full
 /// multiplicity, after which the sheet (bilinear on each side, cubic in `u`) is reproduced
 /// with a few spans: 1e-12 is reached; the deviation at random points stays
-/// within the certificate.
+/// within the measured maximum.
 #[test]
 fn a_crease_is_found_and_followed() {
     struct Crease(f64);
@@ -124,12 +128,12 @@ fn a_crease_is_found_and_followed() {
     assert!(worst <= r.max_deviation * (1.0 + 1e-9) && r.max_deviation <= 1e-12, "{worst} {r:?}");
 }
 
-/// Degree 5: the certificate holds as for degree 3 (random points within the certified
+/// Degree 5: the measured maximum holds as for degree 3 (random points within the measured
 /// maximum), the net is smaller at a tight tolerance, and the edges interpolate the
 /// patch's position, first and second cross derivatives exactly at the Greville points of
 /// `v` — the second derivative only in degree 5.
 #[test]
-fn quintic_faces_are_certified_and_interpolate_the_second_cross_derivative() {
+fn quintic_faces_meet_the_tolerance_and_interpolate_the_second_cross_derivative() {
     let s = Sphere(1.0);
     let tau = std::f64::consts::TAU;
     let tol = 1e-8;
@@ -139,7 +143,7 @@ fn quintic_faces_are_certified_and_interpolate_the_second_cross_derivative() {
     assert!(r5.max_deviation <= tol);
     let worst =
         points(4000, 0.0, tau).map(|(u, v)| (b5.point(u, v) - s.point(u, v)).norm()).fold(0.0, crate::num::max_nan);
-    assert!(worst <= r5.max_deviation * (1.0 + 1e-9), "random {worst} above the certificate {}", r5.max_deviation);
+    assert!(worst <= r5.max_deviation * (1.0 + 1e-9), "random {worst} above the measured maximum {}", r5.max_deviation);
     assert!(r5.points.0 * r5.points.1 < r3.points.0 * r3.points.1, "{:?} vs {:?}", r5.points, r3.points);
     for (b, second) in [(&b3, false), (&b5, true)] {
         for v in b.v.greville() {

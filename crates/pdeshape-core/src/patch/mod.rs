@@ -172,7 +172,7 @@ pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: u
                 1 => at(c.u, j)[1],
                 k => s.u_derivative(c.u, v, k),
             };
-            let e = (x - c.data.eval(&[v, t])).norm();
+            let e = (x - c.data.eval(&[v, t])).scaled_norm();
             max_abs = crate::num::max_nan(max_abs, e);
             if c.order == 0 {
                 lo = lo.min(x);
@@ -186,6 +186,6 @@ pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: u
         }
     }
     // NaN stays NaN (a NaN sample makes the box NaN); a zero size becomes the tiniest
-    let size = crate::num::max_nan((hi - lo).norm(), f64::MIN_POSITIVE);
+    let size = crate::num::max_nan((hi - lo).scaled_norm(), f64::MIN_POSITIVE);
     ConditionReport { max_abs, max_rel: max_abs / size, size }
 }

@@ -188,6 +188,35 @@ fn sides<'a>(s: &'a BSplineSurface, tol: f64) -> Vec<(usize, Side<'a>)> {
     all.into_iter().enumerate().filter(|(_, side)| hull_length(&side.pts) > tol).collect()
 }
 
+/// Checks that the uncertainty `tol` is small beside the face's boundary: each of its four
+/// boundary rows is either a pole (its control polygon shorter than `tol`) or longer than
+/// 100 × `tol`, and at least two are not poles. A tolerance that exceeds the geometry would
+/// otherwise merge corners and drop sides — empty `EDGE_LOOP`s, one-face "closed" shells,
+/// seams between boundaries that do not touch — so it is refused, naming the face.
+pub fn check_uncertainty(name: &str, s: &BSplineSurface, tol: f64) -> Result<(), String> {
+    let rows = [s.v_edge(false), s.u_edge(true), s.v_edge(true), s.u_edge(false)];
+    let what = ["v = v0", "u = 1", "v = v1", "u = 0"];
+    let mut kept = 0;
+    for (r, w) in rows.iter().zip(what) {
+        let l = hull_length(r);
+        if l.is_nan() {
+            return Err(format!("face `{name}`: its boundary {w} is not finite"));
+        }
+        if l > tol && l <= 100.0 * tol {
+            return Err(format!(
+                "face `{name}`: its boundary {w} is {l:.3e} long, within 100 × the tolerance {tol:.3e}; the tolerance exceeds the geometry (lower --tolerance or --relative-tolerance)"
+            ));
+        }
+        kept += usize::from(l > tol);
+    }
+    if kept < 2 {
+        return Err(format!(
+            "face `{name}`: its boundary is shorter than the tolerance {tol:.3e}; the tolerance exceeds the geometry (lower --tolerance or --relative-tolerance)"
+        ));
+    }
+    Ok(())
+}
+
 /// The corners `(0, v₀), (1, v₀), (1, v₁), (0, v₁)` (a clamped net interpolates them).
 fn corners(s: &BSplineSurface) -> [Vec3; 4] {
     let (nu, nv) = s.counts();
@@ -395,7 +424,13 @@ pub fn write_step(w: &mut dyn Write, product: &str, faces: &[StepFace], uncertai
         ));
     }
     if !(uncertainty.is_finite() && uncertainty > 0.0) {
-        return Err(io::Error::new(io::ErrorKind::InvalidData, format!("uncertainty {uncertainty} is not positive")));
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("the uncertainty {uncertainty:e} is not a positive finite number"),
+        ));
+    }
+    for f in faces {
+        check_uncertainty(f.name, f.surface, uncertainty).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     }
     let mut e = Entities { text: String::new(), next: 0 };
     let name = string(product);
