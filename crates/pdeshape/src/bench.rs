@@ -34,6 +34,10 @@ struct Scaling<'a> {
 
 /// Runs every table; prints Markdown (or JSON) and optionally writes both next to `out`.
 pub fn run(runs: usize, json_out: bool, out: Option<&Path>, limits: Limits) -> Result<()> {
+    // outputs are checked before a minute of timing, not after
+    if let Some(path) = out {
+        writable_dir(path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")))?;
+    }
     let scene = example("dynamic-elliptic-cylinders", limits)?;
     let (t1, acc) = tables::on_one_thread(|| -> Result<(Vec<Table1Row>, Vec<AccuracyRow>), String> {
         Ok((tables::dynamic_table1(&scene, runs)?, tables::dynamic_accuracy(&scene)?))
@@ -73,6 +77,14 @@ pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool, limits: Li
     let text = |name: &str| {
         EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t).ok_or_else(|| anyhow!("example {name} missing"))
     };
+    if max_side < 50 {
+        return Err(crate::usage::usage(format!(
+            "--max-side {max_side}: the scaling study's smallest grid side is 50 (sides 50, 100, 200, 500, 1000, 2000 up to --max-side)"
+        )));
+    }
+    if dir.exists() {
+        writable_dir(dir)?;
+    }
     let o = scaling::ScalingOptions { runs, max_side, limits };
     let rows = scaling::run(text("four-curve-patch")?, text("blend-torus-hyperboloid")?, o, |what| {
         if !quiet {
@@ -80,17 +92,31 @@ pub fn scaling(dir: &Path, runs: usize, max_side: usize, quiet: bool, limits: Li
         }
     })
     .map_err(|e| anyhow!(e))?;
-    std::fs::create_dir_all(dir)?;
+    // everything is made before anything is written: a failure leaves no file
     let md = format!("# Scaling study\n\nMachine: {}\n{}", machine(), scaling::markdown(&rows));
-    let doc = Scaling { machine: machine(), rows: &rows };
-    pdeshape_io::export::write_atomic(&dir.join("scaling.md"), |w| w.write_all(md.as_bytes()))?;
-    pdeshape_io::export::write_atomic(&dir.join("scaling.json"), |w| {
-        w.write_all(serde_json::to_string_pretty(&doc)?.as_bytes())
-    })?;
-    for (stem, img) in scaling::plots(&rows).map_err(|e| anyhow!(e))? {
-        pdeshape_io::export::write_atomic(&dir.join(format!("{stem}.png")), |w| img.write_png(w))?;
+    let doc = serde_json::to_string_pretty(&Scaling { machine: machine(), rows: &rows })?;
+    let plots = scaling::plots(&rows).map_err(|e| anyhow!(e))?;
+    std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create the directory {}: {e}", dir.display()))?;
+    let write = |name: String, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        let path = dir.join(name);
+        pdeshape_io::export::write_atomic(&path, f).map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
+    };
+    write("scaling.md".into(), &|w| w.write_all(md.as_bytes()))?;
+    write("scaling.json".into(), &|w| w.write_all(doc.as_bytes()))?;
+    for (stem, img) in &plots {
+        write(format!("{stem}.png"), &|w| img.write_png(w))?;
     }
     print!("{md}");
+    Ok(())
+}
+
+/// `dir` is a directory this process may create files in (checked by creating and
+/// removing a temporary file), or an error naming it.
+fn writable_dir(dir: &Path) -> Result<()> {
+    if !dir.is_dir() {
+        return Err(anyhow!("{} is not a directory", dir.display()));
+    }
+    tempfile::tempfile_in(dir).map_err(|e| anyhow!("cannot write into the directory {}: {e}", dir.display()))?;
     Ok(())
 }
 

@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 /// `--tolerance`, `--relative-tolerance` and `--degree` (STEP output only).
 #[derive(Clone, Copy, Debug)]
 pub struct StepOptions {
-    /// Certified deviation (absolute).
+    /// The measured maximum deviation to reach (absolute).
     pub tolerance: Option<f64>,
-    /// Certified deviation relative to each face's size.
+    /// The same relative to each face's size.
     pub relative_tolerance: Option<f64>,
     /// B-spline degree.
     pub degree: Option<usize>,
@@ -41,7 +41,9 @@ pub fn command(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Resul
     };
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     if (tolerance.is_some() || relative_tolerance.is_some() || degree.is_some()) && ext != "step" && ext != "stp" {
-        bail!("--tolerance, --relative-tolerance and --degree apply to STEP output only (-o FILE.step)");
+        return Err(crate::usage::usage(
+            "--tolerance, --relative-tolerance and --degree apply to STEP output only (-o FILE.step)",
+        ));
     }
     if ext == "step" || ext == "stp" {
         if sc.patches.is_empty() {
@@ -82,7 +84,10 @@ pub fn command(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Resul
             );
         }
     } else if !ext.is_empty() {
-        bail!("unknown output format `.{ext}` (known: obj, ply, stl, glb, vtu, step, png, or a directory)");
+        return Err(crate::usage::usage(format!(
+            "unknown output format `.{}` (known: obj, ply, stl, glb, vtu, step, png, or a directory)",
+            crate::clip::clip(&ext, 16)
+        )));
     } else {
         let files = build_into_dir(sc, out)?;
         if !quiet {
@@ -119,6 +124,12 @@ pub fn write_png(path: &Path, img: &pdeshape_io::render::Image) -> Result<()> {
 /// renamed into place only when all of them were written; a failure on the way removes the
 /// staging directory (and whatever was already renamed), so no partial set is left.
 pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "{} exists and is not a directory (a file output needs an extension: obj, ply, stl, glb, vtu, step, png)",
+            dir.display()
+        );
+    }
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create the directory {}", dir.display()))?;
     let meshes = model::patch_meshes(scene).map_err(|e| anyhow!(e))?;
     let stage = tempfile::Builder::new()

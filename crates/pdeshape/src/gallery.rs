@@ -141,7 +141,10 @@ fn build_one(name: &str, text: &str, dir: &Path, limits: pdeshape_core::limits::
 
 /// Builds the gallery; fails (after building the rest) when any example fails.
 pub fn run(dir: &Path, quiet: bool, limits: pdeshape_core::limits::Limits) -> Result<()> {
-    std::fs::create_dir_all(dir)?;
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("{} exists and is not a directory: the gallery is written into a directory", dir.display());
+    }
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("cannot create the directory {}: {e}", dir.display()))?;
     let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(EXAMPLES.len() as u64) };
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()),

@@ -9,6 +9,7 @@ mod clip;
 mod gallery;
 mod sample;
 mod serve;
+mod usage;
 
 include!(concat!(env!("OUT_DIR"), "/examples.rs"));
 

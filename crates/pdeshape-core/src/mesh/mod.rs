@@ -142,6 +142,62 @@ impl Mesh {
         }
         Ok(())
     }
+
+    /// Checks that every value a single-precision format stores — positions, normals,
+    /// UVs, field values, highlighted curves and animation frames — is a finite `f32` after
+    /// rounding (`|x| < f32::MAX` plus half an ulp); the error names the mesh, the array
+    /// and the index. `format` names the format in the message.
+    ///
+    /// ```
+    /// use pdeshape_core::{Vec3, mesh::Mesh};
+    /// let mut m = Mesh { name: "p".into(), positions: vec![Vec3::new(1e30, 0.0, 0.0)], ..Default::default() };
+    /// assert!(m.check_fits_f32("STL").is_ok());
+    /// m.positions[0].x = 1e39;
+    /// let e = m.check_fits_f32("STL").unwrap_err();
+    /// assert!(e.contains("vertex 0") && e.contains("STL"), "{e}");
+    /// ```
+    pub fn check_fits_f32(&self, format: &str) -> Result<(), String> {
+        self.check_finite()?;
+        let fits = |x: f64| (x as f32).is_finite();
+        let fits3 = |p: &Vec3| fits(p.x) && fits(p.y) && fits(p.z);
+        let err = |what: &str, i: usize| {
+            Err(format!(
+                "mesh `{}`: {what} {i} does not fit the single-precision floats of {format} (|x| ≤ {:e}); scale the scene down",
+                self.name,
+                f32::MAX
+            ))
+        };
+        if let Some(i) = self.positions.iter().position(|p| !fits3(p)) {
+            return err("vertex", i);
+        }
+        if let Some(i) = self.normals.iter().position(|p| !fits3(p)) {
+            return err("the normal of vertex", i);
+        }
+        if let Some(i) = self.uvs.iter().position(|t| !(fits(t[0]) && fits(t[1]))) {
+            return err("the texture coordinate of vertex", i);
+        }
+        for f in &self.fields {
+            if let Some(i) = f.values.iter().position(|x| !fits(*x)) {
+                return err(&format!("field `{}` at vertex", f.name), i);
+            }
+        }
+        for (k, c) in self.curves.iter().enumerate() {
+            if let Some(i) = c.iter().position(|p| !fits3(p)) {
+                return err(&format!("curve {k}, point"), i);
+            }
+        }
+        if let Some(a) = &self.animation {
+            if let Some(i) = a.times.iter().position(|t| !fits(*t)) {
+                return err("animation frame time", i);
+            }
+            for (k, frame) in a.positions.iter().chain(&a.normals).enumerate() {
+                if let Some(i) = frame.iter().position(|p| !fits3(p)) {
+                    return err(&format!("animation array {k}, vertex"), i);
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A hexahedral volume mesh (VTK cell ordering: bottom face counter-clockwise, then top).

@@ -15,7 +15,7 @@ mod vtu;
 pub use gltf::write_glb;
 pub use obj::write_obj;
 pub use ply::write_ply;
-pub use step::{StepFace, StepHole, write_step};
+pub use step::{StepFace, StepHole, check_uncertainty, write_step};
 pub use stl::write_stl;
 pub use vtu::{write_vtu_hex, write_vtu_surface};
 
@@ -25,7 +25,22 @@ use std::path::Path;
 
 /// Writes `path` atomically: `f` writes into a temporary file in the same directory,
 /// which is renamed to `path` only when `f` succeeds.
+///
+/// A path that exists and is not a regular file (a FIFO, a character or block device, a
+/// socket) is never replaced: renaming a regular file over it would leave a FIFO's reader
+/// without data and turn a device node into a file. Its content is first produced in
+/// memory — so a failing `f` writes nothing there either — and then written straight into
+/// it, with every write error reported (a full device answers "no space left"). A directory
+/// is refused. A symbolic link is followed for that decision; a link to a regular file is
+/// replaced by the new file, as before.
 pub fn write_atomic(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => {
+            return Err(io::Error::new(io::ErrorKind::IsADirectory, format!("{} is a directory", path.display())));
+        }
+        Ok(m) if !m.is_file() => return write_into_special(path, f),
+        _ => {}
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -47,6 +62,22 @@ pub fn write_atomic(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// Writes into an existing FIFO or device node: the whole content is made first, then
+/// written in one pass (no truncation, no rename).
+fn write_into_special(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
+    let mut bytes = Vec::new();
+    f(&mut bytes)?;
+    let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
+    file.write_all(&bytes)?;
+    file.flush()?;
+    // a device that buffers (a disk partition) reports a late failure here; a FIFO or a
+    // character device cannot sync, which is no error of the write
+    match file.sync_all() {
+        Err(e) if e.kind() != io::ErrorKind::InvalidInput => Err(e),
+        _ => Ok(()),
+    }
 }
 
 /// An export format.
@@ -77,6 +108,23 @@ impl Format {
         })
     }
 
+    /// Whether the format stores coordinates as 32-bit floats (binary PLY, STL, glTF);
+    /// OBJ and VTU write `f64` values.
+    pub fn single_precision(self) -> bool {
+        matches!(self, Format::Ply | Format::Stl | Format::Glb)
+    }
+
+    /// The format's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Obj => "OBJ",
+            Format::Ply => "PLY",
+            Format::Stl => "STL",
+            Format::Glb => "glTF",
+            Format::Vtu => "VTU",
+        }
+    }
+
     /// The file extension.
     pub fn extension(self) -> &'static str {
         match self {
@@ -90,24 +138,27 @@ impl Format {
 }
 
 /// Writes meshes to `path` in `format` (atomically). Refuses meshes with non-finite
-/// values: no NaN ever reaches a file.
+/// values, and values that overflow a single-precision format's `f32`: no NaN or inf ever
+/// reaches a file.
 pub fn write_meshes(path: &Path, format: Format, meshes: &[&Mesh]) -> io::Result<()> {
-    check_finite(meshes)?;
+    check_representable(format, meshes)?;
     write_atomic(path, |w| encode(w, format, meshes))
 }
 
 /// The bytes of `meshes` in `format`, in memory (the editor's downloads: no file is
-/// involved). Refuses meshes with non-finite values.
+/// involved). Refuses what [`write_meshes`] refuses.
 pub fn to_bytes(format: Format, meshes: &[&Mesh]) -> io::Result<Vec<u8>> {
-    check_finite(meshes)?;
+    check_representable(format, meshes)?;
     let mut out = Vec::new();
     encode(&mut out, format, meshes)?;
     Ok(out)
 }
 
-fn check_finite(meshes: &[&Mesh]) -> io::Result<()> {
+/// Every value of `meshes` is finite and, for a format that stores `f32`, finite as `f32`.
+pub fn check_representable(format: Format, meshes: &[&Mesh]) -> io::Result<()> {
     for m in meshes {
-        m.check_finite().map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
+        let r = if format.single_precision() { m.check_fits_f32(format.name()) } else { m.check_finite() };
+        r.map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     }
     Ok(())
 }
