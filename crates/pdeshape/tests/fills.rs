@@ -103,7 +103,7 @@ fn bad_loops_are_errors_with_the_place() {
     let mut rev = own.clone();
     let w = rev[2].split("w = [0, ").nth(1).unwrap().split(']').next().unwrap().to_string();
     rev[2] = rev[2].replace(&format!("w = [0, {w}]"), &format!("w = [{w}, 0]"));
-    fails(&with(&rev), &["patches.cap.edges", "edge 2 runs the wrong way"]);
+    fails(&with(&rev), &["patches.cap.edges", "edge 2 is reversed"]);
     // an unknown surface, named with its key
     let mut bad = own.clone();
     bad[1] = bad[1].replace("edge1", "edge9");
@@ -265,4 +265,37 @@ fn edge_forms_are_checked() {
         &text.replace(&first, "  { surface = \"edge0\", trim = \"a.b\", t = [0, 1] },"),
         &["patches.cap.edges[0]", "do not combine"],
     );
+}
+
+/// The trust issue's reproducer: a three-edge fill on the trim circle of trim-circle.toml,
+/// whose host sheet is only C0 along the v-lines of its polylines' vertices. The fill tore
+/// (a jump of 0.0167 between adjacent floats) while `check` reported G1 ≤ 1.1e-15 and no
+/// warning. Now the five creases inside the edges are split into corners and named, the
+/// fill is continuous (tear ratio about 1 on a 41 × 4000 grid), and the corners whose
+/// neighbours are not G1 are reported with their angles.
+#[test]
+fn a_fill_on_a_creased_trim_curve_is_split_at_the_creases() {
+    let text = std::fs::read_to_string(example("trim-circle.toml")).unwrap()
+        + "\n[patches.plug]\nkind = \"fill\"\nedges = [\n\
+           { trim = \"sheet.hole\", t = [0, 2.0943951023931953] },\n\
+           { trim = \"sheet.hole\", t = [2.0943951023931953, 4.1887902047863905] },\n\
+           { trim = \"sheet.hole\", t = [4.1887902047863905, 6.283185307179586] },\n]\n";
+    let scene = Scene::parse(&text, "torn.toml", "torn", &Default::default()).unwrap();
+    let p = scene.patch("plug").unwrap();
+    let d = model::patch_diagnostics(p).to_json();
+    let f = &d["fill"];
+    let tear = f["tear_ratio_max"].as_f64().unwrap();
+    // a smooth fill measures 1 plus the grid spacing's term (`Fill::tear`)
+    assert!(tear <= 1.2, "tear ratio {tear}");
+    assert_eq!(f["edges"], 8, "{f}");
+    let warnings: Vec<String> =
+        d["warnings"].as_array().unwrap().iter().map(|w| w.as_str().unwrap().to_string()).collect();
+    assert_eq!(warnings.iter().filter(|w| w.contains("has a crease")).count(), 5, "{warnings:?}");
+    assert!(warnings.iter().any(|w| w.contains("w = 4.0011838")), "{warnings:?}");
+    assert!(!warnings.iter().any(|w| w.contains("the fill jumps")), "{warnings:?}");
+    // the surface is continuous where it jumped (u = 0.078, v near the old tear)
+    let s = p.surface.as_ref();
+    let v0 = 5.0 * std::f64::consts::FRAC_PI_4;
+    let (a, b) = (s.point(0.078, v0), s.point(0.078, v0 + 1e-9));
+    assert!((a - b).norm() < 1e-8, "{a:?} {b:?}");
 }

@@ -21,6 +21,13 @@ pub(crate) struct Piece {
     /// At the start corner: `T_c = a S_s + b S_w` there; likewise at the end corner.
     pub start: (f64, f64),
     pub end: (f64, f64),
+    /// At a corner whose neighbours are not G1 the common cross tangent `T_c` lies in
+    /// neither tangent plane: its part along `N = S_s × S_w`, `T_c = a S_s + b S_w + g N`,
+    /// faded by the same bumps (0 at G1 corners). Without it the cross tangent would jump
+    /// at the corner and the fill with it; with it G1 is given up within that corner's
+    /// blend only, where no surface can meet both neighbours G1.
+    pub start_n: f64,
+    pub end_n: f64,
     /// Second cross derivative (order 2 only): the corrections `γ S_s + δ S_w + η N` that
     /// make it continuous at the start and end corners (`N = S_s × S_w`), faded by the
     /// same bumps as the cross tangent's weights.
@@ -122,17 +129,22 @@ impl LoopData {
         let sw: [Vec<f64>; 3] = std::array::from_fn(|c| {
             (0..=order).map(|j| (j + 1) as f64 * sj.0[c].coeff([0, j + 1, 0]) * lam_pow[j]).collect()
         });
+        let n: [Vec<f64>; 3] = std::array::from_fn(|c| {
+            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+            sub(&mul(&ss[c1], &sw[c2]), &mul(&ss[c2], &sw[c1]))
+        });
         if self.order == 1 {
-            return std::array::from_fn(|c| add(&mul(&alpha, &ss[c]), &mul(&beta, &sw[c])));
+            // T = α S_s + β S_w + ν N, ν = ω_s g_s + ω_e g_e (0 unless a corner is not G1)
+            if p.start_n == 0.0 && p.end_n == 0.0 {
+                return std::array::from_fn(|c| add(&mul(&alpha, &ss[c]), &mul(&beta, &sw[c])));
+            }
+            let nu: Vec<f64> = (0..=order).map(|j| ws[j] * p.start_n + we[j] * p.end_n).collect();
+            return std::array::from_fn(|c| add(&add(&mul(&alpha, &ss[c]), &mul(&beta, &sw[c])), &mul(&nu, &n[c])));
         }
         // Q = α² S_ss + 2αβ S_sw + β² S_ww + ω_s (γ S_s + δ S_w + η N)_s + ω_e (…)_e
         let aa = mul(&alpha, &alpha);
         let ab: Vec<f64> = mul(&alpha, &beta).iter().map(|x| 2.0 * x).collect();
         let bb = mul(&beta, &beta);
-        let n: [Vec<f64>; 3] = std::array::from_fn(|c| {
-            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-            sub(&mul(&ss[c1], &sw[c2]), &mul(&ss[c2], &sw[c1]))
-        });
         std::array::from_fn(|c| {
             let sss: Vec<f64> = (0..=order).map(|j| 2.0 * sj.0[c].coeff([2, j, 0]) * lam_pow[j]).collect();
             let ssw: Vec<f64> =
@@ -223,6 +235,9 @@ impl Field for LoopData {
                 f *= p.lambda;
                 *o *= f;
             }
+        } else if self.order == 1 && (p.start_n != 0.0 || p.end_n != 0.0) {
+            // a corner that is not G1: the normal part through the series
+            crate::data::derivatives_by_jet(self, at, slot, out);
         } else if self.order == 1 && out.len() == 1 {
             let (mut along_s, mut along_w) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2]);
             p.surface.derivatives_in(&on, 0, &mut along_s);
@@ -273,6 +288,8 @@ mod tests {
             c: 1.3,
             start: (0.4, -0.2),
             end: (0.9, 0.35),
+            start_n: 0.0,
+            end_n: 0.0,
             start2: [0.3, -0.1, 0.2],
             end2: [-0.2, 0.4, 0.1],
         };
@@ -316,6 +333,8 @@ mod tests {
             c: 1.3,
             start: (0.4, -0.2),
             end: (0.9, 0.35),
+            start_n: 0.15,
+            end_n: -0.3,
             start2: [0.3, -0.1, 0.2],
             end2: [-0.2, 0.4, 0.1],
         };

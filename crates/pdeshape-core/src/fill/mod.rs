@@ -49,6 +49,7 @@
 //! pole — by linear least squares (see [`FillOptions`]). `height` scales the chosen pole's
 //! offset from the loop's centroid.
 
+mod crease;
 mod curve;
 mod data;
 
@@ -98,6 +99,10 @@ pub struct FillOptions {
     pub pole_curvature: Option<f64>,
     /// The PDE solve.
     pub spectral: SpectralOptions,
+    /// Split every edge at the creases of its neighbour inside it ([`crease::creases`]),
+    /// making each a corner (default `true`; `false` fills across them, which tears the
+    /// fill: for tests of the tear measure).
+    pub split_creases: bool,
 }
 
 impl Default for FillOptions {
@@ -111,6 +116,7 @@ impl Default for FillOptions {
             order: 4,
             pole_curvature: None,
             spectral: SpectralOptions { a: 1.0, modes: 12, omega: None },
+            split_creases: true,
         }
     }
 }
@@ -148,6 +154,14 @@ pub struct FillReport {
     pub corner_curvature_gaps: Vec<f64>,
     /// Order 6: the cap's normal curvature at the pole.
     pub pole_curvature: Option<f64>,
+    /// Edges of the given loop that had no length (all their points within 1e-12 of the
+    /// loop's mean radius) and were dropped: their indices in the given loop. Corners and
+    /// edges elsewhere in the report count the remaining edges.
+    pub dropped_edges: Vec<usize>,
+    /// Creases of a neighbour found inside an edge, where the edge was split and the crease
+    /// made a corner: the edge's index in the loop as given (after dropped edges) and the
+    /// parameter `w` of the crease.
+    pub split_edges: Vec<(usize, f64)>,
 }
 
 /// Continuity along the edges.
@@ -173,6 +187,9 @@ pub struct Fill {
     report: FillReport,
     t: f64,
 }
+
+/// A vector of NaNs: what a degenerate direction becomes in the measures.
+const NAN3: Vec3 = Vec3::new(f64::NAN, f64::NAN, f64::NAN);
 
 /// A constant point plus a ring, `centre + ρ (cos v e₁ + sin v e₂)`, exact in `v`.
 #[derive(Clone, Debug)]
@@ -256,8 +273,13 @@ fn segment_distance(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (f64, Vec3) {
     ((x - y).norm(), x)
 }
 
-/// Two segments of the closed polyline `pts`, not neighbours (at least three apart), closer
-/// than `tol` (NaN positions count): their indices and the place.
+/// Two segments of the closed polyline `pts` closer than `tol` although the polyline runs
+/// at least `4 tol` between them (either way round): the loop comes back to itself. NaN
+/// positions count. Their indices and the place.
+///
+/// The separation is measured along the polyline, not in segment indices: where segments
+/// are shorter than `tol` (a loop of hundreds of edges, one short edge) neighbours a few
+/// indices apart are close without the loop crossing itself.
 ///
 /// Segments are grouped in runs of 8 whose bounding boxes (grown by `tol`) are compared
 /// first; only runs whose boxes meet are compared segment by segment.
@@ -266,6 +288,16 @@ fn self_crossing(pts: &[Vec3], tol: f64) -> Option<(usize, usize, Vec3)> {
     if pts.iter().any(|p| !p.is_finite()) {
         return Some((0, 0, Vec3::new(f64::NAN, f64::NAN, f64::NAN)));
     }
+    // cum[i]: the length of the polyline up to point i; cum[m] the whole loop
+    let mut cum = Vec::with_capacity(m + 1);
+    cum.push(0.0);
+    for i in 0..m {
+        cum.push(cum[i] + (pts[(i + 1) % m] - pts[i]).norm());
+    }
+    let total = cum[m];
+    // along the loop between segments i < j: from i's end to j's start, or from j's end
+    // round to i's start
+    let apart = |i: usize, j: usize| (cum[j] - cum[i + 1]).min(total - cum[j + 1] + cum[i]);
     const RUN: usize = 8;
     let runs: Vec<(Vec3, Vec3)> = (0..m.div_ceil(RUN))
         .map(|r| {
@@ -289,8 +321,8 @@ fn self_crossing(pts: &[Vec3], tol: f64) -> Option<(usize, usize, Vec3)> {
                 continue;
             }
             for i in ra * RUN..((ra + 1) * RUN).min(m) {
-                for j in (rb * RUN).max(i + 3)..((rb + 1) * RUN).min(m) {
-                    if (i + m - j) % m < 3 {
+                for j in (rb * RUN).max(i + 2)..((rb + 1) * RUN).min(m) {
+                    if !(apart(i, j) >= 4.0 * tol) {
                         continue;
                     }
                     let (d, p) = segment_distance(pts[i], pts[(i + 1) % m], pts[j], pts[(j + 1) % m]);
@@ -341,7 +373,12 @@ fn sym_norm(m: [[f64; 2]; 2]) -> f64 {
     mean.abs() + (half * half + m[0][1] * m[0][1]).sqrt()
 }
 
+///
+/// NaN when either normal vanishes: no angle is measured there (it was 0, a perfect G1).
 fn line_angle(a: Vec3, b: Vec3) -> f64 {
+    if a == Vec3::ZERO || b == Vec3::ZERO {
+        return f64::NAN;
+    }
     a.cross(b).norm().atan2(a.dot(b).abs())
 }
 
@@ -434,8 +471,17 @@ impl Fill {
         if n < 3 {
             return Err(FillError::Loop(format!("a hole needs at least 3 edges; got {n}")));
         }
-        if !(o.corner_blend > 0.0 && o.corner_blend <= 0.5) {
-            return Err(FillError::Loop(format!("corner_blend = {} must be in (0, 0.5]", o.corner_blend)));
+        // below 1e-6 of an edge a corner blend is a jump no mesh or fit resolves (and its
+        // derivatives, ~1/width², overflow the report's figures)
+        if !(o.corner_blend >= 1e-6 && o.corner_blend <= 0.5) {
+            return Err(FillError::Loop(format!("corner_blend = {:e} must be in [1e-6, 0.5]", o.corner_blend)));
+        }
+        if !o.height.is_finite() {
+            return Err(FillError::Loop(format!("height = {} must be finite", o.height)));
+        }
+        // a negative ring turns the cap inside out, which the fold count reports
+        if let Some(r) = o.ring.filter(|r| !r.is_finite()) {
+            return Err(FillError::Loop(format!("ring = {r} must be finite")));
         }
         if o.order != 4 && o.order != 6 {
             return Err(FillError::Loop(format!("a fill's order is 4 (G1) or 6 (G2), not {}", o.order)));
@@ -446,22 +492,64 @@ impl Fill {
         let t = o.t;
         // the loop, sampled: closure, orientation, centroid, radius, vector area
         let per = 64;
-        let mut pts = Vec::with_capacity(n * per);
-        for e in edges {
+        let mut samples = Vec::with_capacity(n * (per + 1));
+        for (k, e) in edges.iter().enumerate() {
             if !(e.fullness.is_finite() && e.fullness > 0.0) {
-                return Err(FillError::Loop(format!("an edge's fullness must be positive, not {}", e.fullness)));
+                return Err(FillError::Loop(format!("edge {k}: its fullness must be positive, not {}", e.fullness)));
             }
-            for i in 0..per {
+            for i in 0..=per {
                 let w = e.w.0 + (e.w.1 - e.w.0) * i as f64 / per as f64;
                 let mut p = [Vec3::ZERO];
                 e.surface.derivatives_in(&[e.s0, w, t], 1, &mut p);
-                pts.push(p[0]);
+                samples.push(p[0]);
             }
         }
+        // the closed polyline (each edge's last sample is the next one's first)
+        let pts: Vec<Vec3> = samples.chunks(per + 1).flat_map(|c| c[..per].iter().copied()).collect();
         let centroid = pts.iter().fold(Vec3::ZERO, |a, p| a + *p) * (1.0 / pts.len() as f64);
         let radius = pts.iter().map(|p| (*p - centroid).norm()).sum::<f64>() / pts.len() as f64;
         if !(radius.is_finite() && radius > 0.0) {
             return Err(FillError::Loop(format!("the loop has no extent (mean radius {radius})")));
+        }
+        // edges that are one point (every sample within 1e-12 of the loop's radius of the
+        // first) are dropped, and the loop is filled without them
+        let point_like: Vec<usize> = (0..n)
+            .filter(|&k| {
+                let s = &samples[k * (per + 1)..(k + 1) * (per + 1)];
+                s.iter().all(|p| (*p - s[0]).norm() <= 1e-12 * radius)
+            })
+            .collect();
+        if !point_like.is_empty() {
+            let kept: Vec<FillEdge> =
+                edges.iter().enumerate().filter(|(k, _)| !point_like.contains(k)).map(|(_, e)| e.clone()).collect();
+            if kept.len() < 3 {
+                return Err(FillError::Loop(format!(
+                    "a hole needs at least 3 edges; {} of the {n} have no length (edges {point_like:?})",
+                    point_like.len()
+                )));
+            }
+            let mut fill = Fill::new(&kept, o)?;
+            fill.report.dropped_edges = point_like;
+            return Ok(fill);
+        }
+        // creases of a neighbour inside an edge become corners: the edge is split there
+        if o.split_creases {
+            let mut split = Vec::new();
+            let mut pieces = Vec::new();
+            for (k, e) in edges.iter().enumerate() {
+                let mut start = e.w.0;
+                for (a, b) in crease::creases(e, t) {
+                    pieces.push(FillEdge { w: (start, a), ..e.clone() });
+                    split.push((k, a));
+                    start = b;
+                }
+                pieces.push(FillEdge { w: (start, e.w.1), ..e.clone() });
+            }
+            if !split.is_empty() {
+                let mut fill = Fill::new(&pieces, &FillOptions { split_creases: false, ..o.clone() })?;
+                fill.report.split_edges = split;
+                return Ok(fill);
+            }
         }
         for k in 0..n {
             let (e, f) = (&edges[k], &edges[(k + 1) % n]);
@@ -470,20 +558,46 @@ impl Fill {
             let gap = (end - start).norm();
             // NaN gaps fail too
             if gap.is_nan() || gap > 1e-9 * radius {
-                let reversed = (end - point_frame(f, f.w.1, t).0).norm() <= 1e-9 * radius;
-                return Err(FillError::Loop(if reversed {
-                    format!("edge {} runs the wrong way: it ends where edge {k} ends (swap its w range)", (k + 1) % n)
+                let near = |a: Vec3, b: Vec3| (a - b).norm() <= 1e-9 * radius;
+                let (e_start, f_end) = (point_frame(e, e.w.0, t).0, point_frame(f, f.w.1, t).0);
+                let reversed = if near(end, f_end) {
+                    // f ends where e ends
+                    Some((k + 1) % n)
+                } else if near(e_start, start) {
+                    // e starts where f starts
+                    Some(k)
+                } else if near(e_start, f_end) {
+                    // both: e's start meets f's end
+                    Some(k)
+                } else {
+                    None
+                };
+                return Err(FillError::Loop(if let Some(r) = reversed {
+                    format!(
+                        "edge {r} is reversed: it runs against the loop's direction (swap the ends of its w or t range)"
+                    )
                 } else {
                     format!("edges {k} and {} do not meet: gap {gap:.3e} (relative {:.3e})", (k + 1) % n, gap / radius)
                 }));
             }
         }
+        if let Some(p) = o.pole {
+            let d = (p - centroid).scaled_norm();
+            if !(d <= 1e6 * radius) {
+                return Err(FillError::Loop(format!(
+                    "the pole {p} is {d:.3e} from the loop's centroid, more than 1e6 × the loop's mean radius {radius:.3e}"
+                )));
+            }
+        }
         if let Some((i, j, p)) = self_crossing(&pts, 1e-3 * radius) {
-            return Err(FillError::Loop(format!(
-                "the loop crosses itself: edge {} comes within 1e-3 of the loop radius of edge {} near {p}",
-                i / per,
-                j / per
-            )));
+            let (a, b) = (i / per, j / per);
+            return Err(FillError::Loop(if a == b {
+                format!(
+                    "the loop crosses itself: edge {a} comes back within 1e-3 of the loop radius of itself near {p}"
+                )
+            } else {
+                format!("the loop crosses itself: edge {a} comes within 1e-3 of the loop radius of edge {b} near {p}")
+            }));
         }
         let area =
             (0..pts.len()).fold(Vec3::ZERO, |a, i| a + (pts[i] - centroid).cross(pts[(i + 1) % pts.len()] - centroid));
@@ -504,6 +618,8 @@ impl Fill {
         // corners: the mean cross tangent in each edge's frame
         let mut starts = vec![(0.0, 0.0); n];
         let mut ends = vec![(0.0, 0.0); n];
+        // corners whose neighbours are not G1: the part of the mean along each normal
+        let (mut starts_n, mut ends_n) = (vec![0.0; n], vec![0.0; n]);
         let mut corner_angles = Vec::with_capacity(n);
         for k in 0..n {
             let k1 = (k + 1) % n;
@@ -512,7 +628,18 @@ impl Fill {
             let tc = (ss0 * cs[k] + ss1 * cs[k1]) * 0.5;
             ends[k] = in_frame(ss0, sw0, tc);
             starts[k1] = in_frame(ss1, sw1, tc);
-            corner_angles.push(line_angle(ss0.cross(sw0), ss1.cross(sw1)));
+            let angle = line_angle(ss0.cross(sw0), ss1.cross(sw1));
+            // as `check` judges corners (1e-9 rad): below, the planes are one and the mean
+            // lies in both
+            if angle > 1e-9 {
+                let normal_part = |ss: Vec3, sw: Vec3, (a, b): (f64, f64)| {
+                    let nn = ss.cross(sw);
+                    (tc - ss * a - sw * b).dot(nn) / nn.dot(nn)
+                };
+                ends_n[k] = normal_part(ss0, sw0, ends[k]);
+                starts_n[k1] = normal_part(ss1, sw1, starts[k1]);
+            }
+            corner_angles.push(angle);
         }
         // order 6, corners: the second cross derivative `Q = d²/du² S(s₀ + αu, w + βu)` from
         // each side, their mean `Q_c`, and the correction `Q_c − Q` in each edge's frame
@@ -530,7 +657,7 @@ impl Fill {
                 ends2[k] = in_frame3(f0[1], f0[2], f0[1].cross(f0[2]), qc - q0);
                 starts2[k1] = in_frame3(f1[1], f1[2], f1[1].cross(f1[2]), qc - q1);
                 let tc = f0[1] * ends[k].0 + f0[2] * ends[k].1;
-                let nrm = f0[1].cross(f0[2]).normalized().unwrap_or(Vec3::ZERO);
+                let nrm = f0[1].cross(f0[2]).normalized().unwrap_or(NAN3);
                 corner_curvature_gaps.push((q1 - q0).dot(nrm).abs() / tc.dot(tc) * radius);
             }
         }
@@ -545,6 +672,8 @@ impl Fill {
                 c: cs[k],
                 start: starts[k],
                 end: ends[k],
+                start_n: starts_n[k],
+                end_n: ends_n[k],
                 start2: starts2[k],
                 end2: ends2[k],
             })
@@ -599,8 +728,17 @@ impl Fill {
         let conds = with_pole(&data, &conds);
         let pole_curvature = (o.order == 6).then(|| data.sigma / (rho * rho));
         let patch = Arc::new(SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?);
-        let report =
-            FillReport { corner_angles, pole, centroid, radius, normal, corner_curvature_gaps, pole_curvature };
+        let report = FillReport {
+            corner_angles,
+            pole,
+            centroid,
+            radius,
+            normal,
+            corner_curvature_gaps,
+            pole_curvature,
+            dropped_edges: Vec::new(),
+            split_edges: Vec::new(),
+        };
         Ok(Fill { patch, conditions: conds.to_vec(), position, report, t })
     }
 
@@ -650,8 +788,9 @@ impl Fill {
         let f = self.position.frame2(v, self.t);
         // both second fundamental forms against the fill's normal, in one orthonormal basis
         // of its tangent plane
-        let nrm = d[3].cross(d[1]).normalized().unwrap_or(Vec3::ZERO);
-        let e1 = d[1].normalized().unwrap_or(Vec3::ZERO);
+        // a degenerate normal or tangent is NaN, so every measure there is NaN (not 0)
+        let nrm = d[3].cross(d[1]).normalized().unwrap_or(NAN3);
+        let e1 = d[1].normalized().unwrap_or(NAN3);
         let e2 = nrm.cross(e1);
         let fill = second_form_in([d[3], d[1], d[6], d[4], d[2]], nrm, e1, e2);
         let nb = second_form_in([f[1], f[2], f[3], f[4], f[5]], nrm, e1, e2);
@@ -691,6 +830,44 @@ impl Fill {
             }
         }
         folds
+    }
+
+    /// The fill's own continuity, measured on an `nu × nv` grid (`u ≤ 0.98`, away from the
+    /// pole): between neighbouring grid points the step `|ΔX|` over the grid spacing `h`
+    /// times the larger `|∂X|` at its two ends, maximised over all steps in `u` and in `v`,
+    /// with the place of the largest. Where `X` is continuously differentiable,
+    /// `|ΔX| ≤ h max|∂X| + h²/2 max|∂²X|`, so the ratio is 1 plus a term that vanishes with
+    /// `h`; a jump of the surface (data that jump inside an edge) between two grid points
+    /// makes it `|jump| / (h |∂X|)`, far above 1 at any `nv` in the thousands. NaN
+    /// propagates.
+    pub fn tear(&self, nu: usize, nv: usize) -> (f64, (f64, f64)) {
+        let us: Vec<f64> = (0..nu).map(|i| 0.98 * i as f64 / (nu - 1) as f64).collect();
+        let vs: Vec<f64> = (0..nv).map(|j| TAU * (j as f64 + 0.5) / nv as f64).collect();
+        let g = self.patch.grid(&us, &vs);
+        let at = |i: usize, j: usize| &g[i * nv + j % nv];
+        let (hu, hv) = (0.98 / (nu - 1) as f64, TAU / nv as f64);
+        // a step of 0 is no tear (also where the derivative is 0 too); NaN stays NaN
+        let ratio = |a: &[Vec3; 4], b: &[Vec3; 4], k: usize, h: f64| {
+            let step = (b[0] - a[0]).norm();
+            if step == 0.0 { 0.0 } else { step / (h * crate::num::max_nan(a[k].norm(), b[k].norm())) }
+        };
+        let (mut worst, mut place) = (0.0, (0.0, 0.0));
+        for i in 0..nu {
+            for j in 0..nv {
+                let p = at(i, j);
+                let mut r = ratio(p, at(i, j + 1), 2, hv);
+                if i + 1 < nu {
+                    r = crate::num::max_nan(r, ratio(p, at(i + 1, j), 1, hu));
+                }
+                if r.is_nan() {
+                    return (f64::NAN, (us[i], vs[j]));
+                }
+                if r > worst {
+                    (worst, place) = (r, (us[i], vs[j]));
+                }
+            }
+        }
+        (worst, place)
     }
 }
 

@@ -299,10 +299,25 @@ fn section_distances(p: &ScenePatch, fam: &SectionFamily, d: &mut PatchReport) {
     d.section_reference_worst = Some(SectionWorst { u: at[0], v: at[1], s: at[2] });
 }
 
+/// Above this a fill's tear ratio ([`FillReport::tear_ratio_max`]) is a warning: a smooth
+/// fill measures 1 plus a term of the grid spacing (at most 1.004 on the examples), a torn
+/// one `|jump| / (h |∂X|)`, over 10 for a jump of 2 % of the loop's radius.
+pub const TEAR_WARNING: f64 = 2.0;
+
 /// A fill's section; warnings for corners where the neighbours themselves disagree.
 fn fill_report(f: &pdeshape_core::fill::Fill, warnings: &mut Vec<String>) -> FillReport {
     let r = f.report();
     let e = f.edge_continuity(1000);
+    for (k, w) in &r.split_edges {
+        warnings.push(format!(
+            "edge {k}: its neighbour has a crease (only C0) at w = {w}: the edge was split there and the crease made a corner (corners are numbered over the split edges)"
+        ));
+    }
+    for k in &r.dropped_edges {
+        warnings.push(format!(
+            "edge {k} has no length and was dropped: the loop is filled by the other edges (corners are numbered over those)"
+        ));
+    }
     for (k, a) in r.corner_angles.iter().enumerate() {
         if a.is_nan() || *a > 1e-9 {
             warnings.push(format!(
@@ -317,7 +332,14 @@ fn fill_report(f: &pdeshape_core::fill::Fill, warnings: &mut Vec<String>) -> Fil
             ));
         }
     }
+    let (tear, (tu, tv)) = f.tear(41, 4000);
+    if !(tear <= TEAR_WARNING) {
+        warnings.push(format!(
+            "the fill jumps near (u, v) = ({tu:.4}, {tv:.4}): a step between neighbouring points is {tear:.3e} × what its derivatives allow; the loop's data are not continuous there"
+        ));
+    }
     FillReport {
+        tear_ratio_max: tear,
         edges: r.corner_angles.len(),
         edge_samples: e.samples,
         g1_max_radians: e.g1,
@@ -362,7 +384,7 @@ fn spectral_report(
             n += 1.0;
         }
     }
-    let leb = r.lebesgue.0.max(r.lebesgue.1.unwrap_or(0.0));
+    let leb = pdeshape_core::num::max_nan(r.lebesgue.0, r.lebesgue.1.unwrap_or(0.0));
     if leb > LEBESGUE_WARNING {
         warnings.push(format!(
             "the condition set amplifies its data by up to {leb:.3e} between conditions (Lebesgue constant): \

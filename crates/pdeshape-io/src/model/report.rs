@@ -352,6 +352,10 @@ pub struct FillReport {
     pub corner_normal_angles_radians: Vec<f64>,
     /// Folded cells of a 41 × 400 grid.
     pub folds: usize,
+    /// The fill's own continuity on a 41 × 4000 grid: the largest step between
+    /// neighbouring points over the spacing times the larger derivative at its ends
+    /// (`Fill::tear`): about 1 where the fill is smooth, far above where it jumps.
+    pub tear_ratio_max: f64,
     /// The pole.
     pub pole: [f64; 3],
     /// The loop's mean radius.

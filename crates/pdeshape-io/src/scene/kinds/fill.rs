@@ -146,6 +146,7 @@ pub(super) fn build_fill(
             .map(|x| ctx.num(x.get_ref(), span(x), &format!("{key}.pole_curvature")))
             .transpose()?,
         spectral: SpectralOptions { a, modes, omega },
+        split_creases: true,
     };
     let fill = Fill::new(&list, &opts).map_err(|e| ctx.err(span(edges), format!("{key}.edges"), e.to_string()))?;
     let resolution = ctx.resolution(&rp.resolution, (41, 201), &format!("{key}.resolution"))?;
