@@ -12,6 +12,8 @@ pub fn command(sc: &Scene, json: bool, cad: bool, degree: Option<usize>) -> Resu
     let o = pdeshape_io::cad::CadOptions { degree: degree.unwrap_or(3), ..Default::default() };
     let fitted = if cad { Some(pdeshape_io::cad::fit_scene(sc, &o).map_err(|e| anyhow!(e))?) } else { None };
     d.cad = fitted.as_deref().map(pdeshape_io::cad::CadReport::of);
+    // a report with a NaN or inf is an error, not a `null` among the figures
+    check_finite_report(&d)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&d)?);
     } else {
@@ -23,7 +25,7 @@ pub fn command(sc: &Scene, json: bool, cad: bool, degree: Option<usize>) -> Resu
             }
         }
     }
-    check_finite_report(&d)
+    Ok(())
 }
 
 /// The continuity line of a patch's report: the gaps at both trimlines, the class and
@@ -51,11 +53,26 @@ pub fn continuity_line(p: &PatchReport) -> Option<String> {
 
 /// Refuses a scene whose own condition check is not finite (an overflowing domain, data of
 /// 1e300): its meshes would hold finite but meaningless numbers.
+///
+/// Every other figure of the report must be finite too (a fill whose corner blend
+/// underflows, a pole at 1e300): the error names the patch and the figure's key path as
+/// `check --json` spells it.
 pub fn check_finite_report(d: &SceneReport) -> Result<()> {
-    match d.first_not_finite() {
-        Some(p) => bail!(not_finite(&p.name)),
-        None => Ok(()),
+    if let Some(p) = d.first_not_finite() {
+        bail!(not_finite(&p.name));
     }
+    for p in &d.patches {
+        if let Some(path) = model::first_non_finite(p) {
+            bail!(
+                "patch `{}`: its report's `{path}` is not finite (the values overflow or are undefined): the result is not usable; check the scene's parameters and the data's magnitude",
+                p.name
+            );
+        }
+    }
+    if let Some(path) = d.cad.as_ref().and_then(model::first_non_finite) {
+        bail!("the CAD fit's `cad.{path}` is not finite: the STEP faces are not usable");
+    }
+    Ok(())
 }
 
 pub fn not_finite(patch: &str) -> String {
@@ -156,19 +173,19 @@ fn json_text<T: serde::Serialize>(x: &T) -> String {
     serde_json::to_string(x).unwrap_or_default()
 }
 
-/// The figures of a scene's CAD fit, one line each: faces (net, certified deviation,
+/// The figures of a scene's CAD fit, one line each: faces (net, measured deviation,
 /// holes) and seams (gap and normal angle after the fit).
 pub fn cad_lines(fitted: &[pdeshape_io::cad::CadFace]) -> Vec<String> {
     let mut out = Vec::new();
     for f in fitted {
         let r = &f.report;
         out.push(format!(
-            "face {}: B-spline {} × {} control points, certified deviation {:.3e} ≤ {:.3e}",
+            "face {}: B-spline {} × {} control points, measured deviation {:.3e} ≤ {:.3e}",
             f.name, r.points.0, r.points.1, r.max_deviation, r.tolerance
         ));
         for h in &f.holes {
             out.push(format!(
-                "  hole {}: B-spline curve, {} control points, certified deviation {:.3e} from the face",
+                "  hole {}: B-spline curve, {} control points, measured deviation {:.3e} from the face",
                 h.name,
                 h.curve.control.len(),
                 h.deviation

@@ -23,6 +23,12 @@ pub struct Cli {
     /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
     #[arg(long = "limit", global = true, value_name = "CAP=VALUE", value_parser = limit)]
     limit: Vec<String>,
+    /// Longest time in seconds: for build, check, sample and render the whole command
+    /// (default 600; the solvers and meshing loops stop at their next checkpoint, nothing
+    /// is written), for serve each request from its arrival, queueing included (default
+    /// 30); gallery and bench have none unless given. 0: no limit.
+    #[arg(long = "time-limit", global = true, value_name = "SECONDS", value_parser = max_time)]
+    time_limit: Option<f64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -38,7 +44,7 @@ enum Command {
         /// Output file or directory.
         #[arg(short, long)]
         out: PathBuf,
-        /// STEP only: the certified maximum deviation of every B-spline face from its patch
+        /// STEP only: the measured maximum deviation of every B-spline face from its patch
         /// (absolute; default 1e-6 × each patch's bounding-box diagonal).
         #[arg(long, value_parser = positive, conflicts_with = "relative_tolerance")]
         tolerance: Option<f64>,
@@ -64,7 +70,7 @@ enum Command {
         /// Solver for blends: auto, exact or collocation (overrides the scene).
         #[arg(long)]
         solver: Option<String>,
-        /// Also fit the faces a STEP export would write and report each face's certified
+        /// Also fit the faces a STEP export would write and report each face's measured
         /// deviation and control points, and each seam's gap and angle after the fit.
         #[arg(long)]
         cad: bool,
@@ -146,9 +152,9 @@ enum Command {
         /// Print JSON instead of Markdown.
         #[arg(long)]
         json: bool,
-        /// Timed runs per measurement (medians are reported).
-        #[arg(long, default_value_t = 21)]
-        runs: usize,
+        /// Timed runs per measurement (medians are reported; 1 to 10000).
+        #[arg(long, default_value_t = 21, value_parser = clap::value_parser!(u64).range(1..=10_000))]
+        runs: u64,
         /// Also write the tables to OUT.md and OUT.json.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -173,10 +179,6 @@ enum Command {
         /// Print the URL to open (it is always printed on start).
         #[arg(long)]
         open: bool,
-        /// Longest time in seconds from a request's arrival to its answer, queueing
-        /// included; a solve past it is cancelled.
-        #[arg(long, default_value_t = crate::serve::SOLVE_LIMIT.as_secs_f64(), value_parser = positive_seconds)]
-        time_limit: f64,
     },
 }
 
@@ -198,7 +200,11 @@ fn spline_degree(s: &str) -> Result<usize, String> {
 /// A camera elevation in degrees.
 fn elevation(s: &str) -> Result<f64, String> {
     let x = finite(s)?;
-    if (-90.0..=90.0).contains(&x) { Ok(x) } else { Err(format!("{x} is outside [-90, 90] degrees")) }
+    if (-90.0..=90.0).contains(&x) {
+        Ok(x)
+    } else {
+        Err(format!("`{}` is outside [-90, 90] degrees", clip(s.trim(), 40)))
+    }
 }
 
 /// A surface view of `render --view`.
@@ -209,20 +215,27 @@ fn view(s: &str) -> Result<pdeshape_io::render::View, String> {
 /// A stripe count: 1 to 200.
 fn stripes(s: &str) -> Result<f64, String> {
     let x = finite(s)?;
-    if (1.0..=200.0).contains(&x) { Ok(x) } else { Err(format!("{x} is outside [1, 200]")) }
+    if (1.0..=200.0).contains(&x) { Ok(x) } else { Err(format!("`{}` is outside [1, 200]", clip(s.trim(), 40))) }
 }
 
 /// A positive finite number.
 fn positive(s: &str) -> Result<f64, String> {
     let x = finite(s)?;
-    if x > 0.0 { Ok(x) } else { Err(format!("{x} is not positive")) }
+    if x > 0.0 { Ok(x) } else { Err(format!("`{}` is not positive", clip(s.trim(), 40))) }
 }
 
-/// A time limit in seconds: positive, at most a day.
-fn positive_seconds(s: &str) -> Result<f64, String> {
+/// `--time-limit`: 0 (no limit) or a positive time of at most a week.
+fn max_time(s: &str) -> Result<f64, String> {
     let x = finite(s)?;
-    if x > 0.0 && x <= 86400.0 { Ok(x) } else { Err(format!("{x} is outside (0, 86400] seconds")) }
+    if (0.0..=604_800.0).contains(&x) {
+        Ok(x)
+    } else {
+        Err(format!("`{}` is outside [0, 604800] seconds", clip(s.trim(), 40)))
+    }
 }
+
+/// The default `--time-limit` of the commands that load one scene.
+pub const DEFAULT_MAX_TIME: f64 = 600.0;
 
 /// `NAME=VALUE` of `--set`, the value finite.
 fn setting(s: &str) -> Result<(String, f64), String> {
@@ -251,7 +264,16 @@ pub fn run() -> i32 {
     for l in &cli.limit {
         limits.apply(l).expect("checked by clap");
     }
-    let result = execute(cli, limits);
+    let max_time = match (&cli.command, cli.time_limit) {
+        // serve applies its limit to each request
+        (Command::Serve { .. }, _) => 0.0,
+        (_, Some(t)) => t,
+        (Command::Build { .. } | Command::Check { .. } | Command::Sample { .. } | Command::Render { .. }, None) => {
+            DEFAULT_MAX_TIME
+        }
+        _ => 0.0,
+    };
+    let result = if max_time > 0.0 { within(max_time, move || execute(cli, limits)) } else { execute(cli, limits) };
     if std::env::var_os("PDESHAPE_SOLVE_COUNTS").is_some() {
         // a test hook: the solves of the whole command, and those done while loading
         let loaded = LOADED.get().copied().unwrap_or_default();
@@ -260,12 +282,45 @@ pub fn run() -> i32 {
     match result {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            let usage = e
-                .chain()
-                .any(|c| c.downcast_ref::<pdeshape_io::scene::SceneError>().is_some_and(|s| s.key.starts_with("--")));
+            // hostile input echoed in the message is escaped and cut (a scene's keys can
+            // hold escapes; a message is at most 4000 characters)
+            eprintln!("error: {}", crate::clip::printable(&format!("{e:#}"), 4000));
+            let usage = e.chain().any(|c| {
+                c.is::<crate::usage::Usage>()
+                    || c.downcast_ref::<pdeshape_io::scene::SceneError>().is_some_and(|s| s.key.starts_with("--"))
+            });
             if usage { 2 } else { 1 }
         }
+    }
+}
+
+/// Runs `f` under a deadline `seconds` from now: a watchdog raises the cancel flag then,
+/// and the computation unwinds at its next checkpoint (`pdeshape_core::cancel`) into an
+/// error naming the limit and the flag that raises it. Files are written atomically, so a
+/// stopped command leaves none.
+fn within(seconds: f64, f: impl FnOnce() -> Result<()> + Send) -> Result<()> {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let flag = Arc::new(AtomicBool::new(false));
+    let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+    let watchdog = {
+        let flag = flag.clone();
+        let limit = std::time::Duration::from_secs_f64(seconds);
+        std::thread::spawn(move || {
+            if let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = done_rx.recv_timeout(limit) {
+                flag.store(true, Ordering::SeqCst);
+            }
+        })
+    };
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let r = pdeshape_core::cancel::run(&flag, threads, f);
+    drop(done_tx);
+    let _ = watchdog.join();
+    match r {
+        Ok(r) => r,
+        Err(pdeshape_core::cancel::Cancelled) => Err(anyhow!(
+            "the command ran past its time limit of {seconds} s and was stopped (nothing was written); raise it with `--time-limit SECONDS` (0: no limit), or lower the scene's resolution, modes or order"
+        )),
     }
 }
 
@@ -307,6 +362,7 @@ impl Load<'_> {
 
 fn execute(cli: Cli, limits: Limits) -> Result<()> {
     let quiet = cli.quiet;
+    let time_limit = cli.time_limit;
     let loader = |set, solver, terms: Option<u64>| Load { limits, set, solver, terms: terms.map(|t| t as usize) };
     match cli.command {
         Command::Build { scene, out, set, tolerance, relative_tolerance, degree } => {
@@ -363,15 +419,20 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, quiet, limits),
         Command::Bench { scaling: Some(dir), runs, max_side, .. } => {
-            crate::bench::scaling(&dir, runs, max_side, quiet, limits)
+            crate::bench::scaling(&dir, runs as usize, max_side, quiet, limits)
         }
-        Command::Bench { json, runs, out, .. } => crate::bench::run(runs, json, out.as_deref(), limits),
-        Command::Serve { scene, port, host, open: _, time_limit } => crate::serve::run(crate::serve::ServeOptions {
+        Command::Bench { json, runs, out, .. } => crate::bench::run(runs as usize, json, out.as_deref(), limits),
+        Command::Serve { scene, port, host, open: _ } => crate::serve::run(crate::serve::ServeOptions {
             scene,
             host,
             port,
             limits,
-            time_limit: std::time::Duration::from_secs_f64(time_limit),
+            // 0: no limit (a week, which no request waits for)
+            time_limit: match time_limit {
+                None => crate::serve::SOLVE_LIMIT,
+                Some(t) if t > 0.0 => std::time::Duration::from_secs_f64(t),
+                Some(_) => std::time::Duration::from_secs(604_800),
+            },
         }),
     }
 }

@@ -343,8 +343,9 @@ fn bad_arguments_and_stdin() {
     assert_eq!(code, 2);
     let (code, _, _) = run(&["build", p], "");
     assert_eq!(code, 2, "missing -o is a usage error");
+    // an output that names no known format is a usage error
     let (code, _, err) = run(&["build", p, "-o", dir.path().join("x.dwg").to_str().unwrap()], "");
-    assert_eq!(code, 1);
+    assert_eq!(code, 2);
     assert!(err.contains("unknown output format `.dwg`"), "{err}");
     assert!(!dir.path().join("x.dwg").exists());
 }
@@ -549,16 +550,18 @@ mod hostile {
         assert!(!out.exists());
         let (code, _, err) = run(&["check", &p], "");
         assert_eq!(code, 1, "{err}");
-        // finite but not interpolating (cos v over [0, 1e300]): `check` warns with the figure
+        // finite positions, but the residual figures over [0, 1e300] overflow: the report
+        // has an inf, so `check` fails naming the figure (it printed a warning and exited 0
+        // with `null` in the JSON)
         let p = scene_file(
             &dir,
             &text
                 .replace("expr = [\"v\", \"0\", \"0\"]", "expr = [\"cos(v)\", \"sin(v)\", \"0\"]")
                 .replace("expr = [\"v\", \"0\", \"1\"]", "expr = [\"cos(v)\", \"sin(v)\", \"1\"]"),
         );
-        let (code, out, err) = run(&["check", &p], "");
-        assert_eq!(code, 0, "{err}");
-        assert!(out.contains("warning: the patch meets its conditions only to"), "{out}");
+        let (code, _, err) = run(&["check", &p], "");
+        assert_eq!(code, 1, "{err}");
+        assert!(err.contains("patch `p`") && err.contains("spectral.") && err.contains("not finite"), "{err}");
     }
 
     /// Small ones: an overflowing cap value, a 200 KB line echoed twice on stderr, an
@@ -586,4 +589,86 @@ mod hostile {
         assert_eq!(code, 1);
         assert!(!err.contains("Vec3 {"), "{err}");
     }
+}
+
+/// `check` on `scene` (written to a file) with `args`: exit 1, no panic, every string of
+/// `expect` in the error; the time it took.
+fn check_fails(scene: &str, args: &[&str], expect: &[&str]) -> std::time::Duration {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let t = std::time::Instant::now();
+    let a = Command::cargo_bin("pdeshape").unwrap().arg("check").arg(&path).args(args).assert();
+    let took = t.elapsed();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    for e in expect {
+        assert!(err.contains(e), "expected `{e}` in\n{err}");
+    }
+    took
+}
+
+fn example_text(name: &str) -> String {
+    std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).unwrap()
+}
+
+/// The Klein bottle at 100 modes (within every cap) ran `check` for 42 s, at 512 past 9
+/// minutes: `--time-limit` stops it at its next checkpoint with an error naming the limit
+/// and how to raise it.
+#[test]
+fn the_time_limit_stops_a_long_command() {
+    let scene = example_text("klein-bottle.toml").replace("modes = 6", "modes = 100");
+    let took = check_fails(&scene, &["--time-limit", "1"], &["time limit of 1 s", "--time-limit"]);
+    // the solve checks the flag between modes: well within seconds of the limit
+    assert!(took.as_secs_f64() < 15.0, "{took:?}");
+}
+
+/// Fill and spectral settings whose results overflow or vanish (`check` exited 0 with NaN
+/// and inf in its report, `omega = 1e100` STEP ran 64 s): refused up front, naming the
+/// setting.
+#[test]
+fn fill_settings_that_overflow_are_refused() {
+    let base = example_text("fill-sphere-triangle.toml");
+    let cases: [(&str, &str, &[&str]); 5] = [
+        ("corner_blend", "a = 2.0\ncorner_blend = 1e-300", &["corner_blend = 1e-300", "[1e-6, 0.5]"]),
+        ("a", "a = 1e300", &["exponential rate", "lower a or ω"]),
+        ("omega", "a = 2.0\nomega = 1e300", &["exponential rate"]),
+        ("omega 1e100", "a = 2.0\nomega = 1e100", &["exponential rate"]),
+        ("height", "a = 2.0\nheight = 1e400", &["height"]),
+    ];
+    for (what, with, expect) in cases {
+        let scene = base.replacen("a = 2.0", with, 1);
+        assert_ne!(scene, base, "{what}");
+        check_fails(&scene, &[], expect);
+    }
+    let scene = base.replace("pole = [0, 0, \"pz\"]", "pole = [1e300, 0, 1]");
+    assert_ne!(scene, base);
+    check_fails(&scene, &[], &["the pole", "1e6 × the loop's mean radius"]);
+}
+
+/// Hostile text echoed in an error is escaped (an ANSI escape in a TOML key reached the
+/// terminal raw) and cut.
+#[test]
+fn control_characters_in_errors_are_escaped() {
+    let scene = format!("{}\n[patches.p.\"x\\u001b[31mred\"]\n", good());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let o = Command::cargo_bin("pdeshape").unwrap().arg("check").arg(&path).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains('\u{1b}'), "a raw escape: {err:?}");
+    assert!(err.contains("\\u{1b}"), "{err:?}");
+    // a numeric argument is echoed as given, cut, not printed with 300 digits
+    let o = Command::cargo_bin("pdeshape")
+        .unwrap()
+        .args(["render", "x.toml", "-o", "x.png", "--stripes"])
+        .arg(format!("1e-300{}", "0".repeat(1000)))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.len() < 1500, "{} bytes: {err}", err.len());
 }

@@ -35,6 +35,9 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::{Arc, OnceLock};
 
+/// The largest exponential rate (`a·M`, `ω`) a spectral patch takes.
+pub const MAX_RATE: f64 = 1e6;
+
 /// Options of the spectral solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpectralOptions {
@@ -193,6 +196,16 @@ impl SpectralPatch {
                     opts.modes + 1
                 ),
             }));
+        }
+        // a rate r puts the data's reach at 1/r of the domain: past 1e6 the whole patch is
+        // a boundary layer thinner than any mesh or fit resolves (and a·M overflows the
+        // exponentials long before it is infinite)
+        let top = (opts.a * opts.modes as f64).max(omega);
+        if top > MAX_RATE {
+            return Err(SpectralError::Options(format!(
+                "the exponential rate {top:e} (a·M = {:e}, ω = {omega:e}) is above {MAX_RATE:e}: the boundary data would reach less than 1e-6 of the domain; lower a or ω",
+                opts.a * opts.modes as f64
+            )));
         }
         let specs: Vec<CondSpec> = conds.iter().map(|c| CondSpec { u: c.u, order: c.order }).collect();
         let dmax = specs.iter().map(|c| c.order).max().unwrap_or(0);

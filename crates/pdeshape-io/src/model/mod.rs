@@ -10,11 +10,13 @@ use pdeshape_core::patch::PrimarySurface;
 use pdeshape_core::patch::{CurvatureKind, Surface};
 
 mod diagnose;
+mod finite;
 pub mod report;
 pub use diagnose::{
     LEBESGUE_WARNING, attached_ends, blend_condition_report, condition_report, continuity_report, patch_diagnostics,
     scene_diagnostics,
 };
+pub use finite::first_non_finite;
 
 /// Number of `v` samples per condition in the exactness check (SPEC §3: ≥ 1000).
 pub const CHECK_SAMPLES: usize = 1000;
