@@ -112,7 +112,7 @@ fn export_never_writes_a_path_from_the_request() {
     }
 }
 
-/// The editor's STEP download: certified B-spline faces of the model at the editor's
+/// The editor's STEP download: measured B-spline faces of the model at the editor's
 /// time (a dynamic blend's frame), with the scene's sanitised name; an unknown format is
 /// refused.
 #[test]
@@ -315,4 +315,96 @@ fn heavy_blend(text: &str) -> String {
     let mut out = text.to_string();
     out.insert_str(at, "solver = \"collocation\"\ncollocation = [500, 500]\nbubbles = 512\n");
     out
+}
+
+/// Regression (medium): four slow downloads from one client made every light request of
+/// another fail (20 × 429, 6 × 503). Downloads have their own slot and queue now: while four
+/// clients keep the export lane busy with solves that run past the limit, 26 light
+/// requests of a fifth client are all answered, each well within the limit.
+#[test]
+fn slow_downloads_do_not_starve_live_requests() {
+    let (_k, addr) = start(&["--time-limit", "2"]);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let exporters: Vec<_> = (0..4)
+        .map(|_| {
+            let (addr, stop) = (addr.clone(), stop.clone());
+            std::thread::spawn(move || {
+                let mut statuses = Vec::new();
+                while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+                    let a = post_json(&addr, "/api/export?format=step", &serde_json::json!({"text": slow_scene()}));
+                    statuses.push((a.status, a.text()));
+                }
+                statuses
+            })
+        })
+        .collect();
+    // let the exports fill their lane first
+    std::thread::sleep(Duration::from_millis(500));
+    let light = scene("hermite-ruled.toml");
+    for k in 0..26 {
+        let t = Instant::now();
+        let a = post_json(&addr, "/api/model", &serde_json::json!({"text": light}));
+        assert_eq!(a.status, 200, "light request {k}: {}", a.text());
+        assert!(t.elapsed() < Duration::from_millis(1500), "light request {k} took {:?}", t.elapsed());
+    }
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    for h in exporters {
+        for (status, text) in h.join().unwrap() {
+            // past the limit (503, worded as a stop or a queue time-out) or refused (429)
+            assert!(status == 503 || status == 429, "{status}: {text}");
+            if status == 503 {
+                assert!(text.contains("was stopped") || text.contains("in the queue"), "{text}");
+            }
+        }
+    }
+}
+
+/// Regression (medium): connections that send half a request and then nothing stayed open
+/// for ever (40 still open after 65 s). With `--time-limit 1` a connection silent for
+/// 1 + 5 s is closed; the server still answers afterwards.
+#[test]
+fn stalled_connections_are_closed() {
+    let (_k, addr) = start(&["--time-limit", "1"]);
+    let mut stalled: Vec<TcpStream> = (0..5)
+        .map(|_| {
+            let mut s = TcpStream::connect(&addr).unwrap();
+            s.write_all(b"GET / HTTP/1.1\r\nHost: ").unwrap();
+            s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+            s
+        })
+        .collect();
+    let t = Instant::now();
+    for s in &mut stalled {
+        let mut buf = [0u8; 64];
+        // closed by the server: end of stream (or a reset), not our read time-out
+        match s.read(&mut buf) {
+            Ok(n) => assert!(n == 0 || String::from_utf8_lossy(&buf[..n]).starts_with("HTTP/1.1 4"), "{n} bytes"),
+            Err(e) => {
+                assert!(matches!(e.kind(), std::io::ErrorKind::ConnectionReset | std::io::ErrorKind::BrokenPipe), "{e}")
+            }
+        }
+    }
+    let closed_after = t.elapsed();
+    assert!(closed_after >= Duration::from_secs(5) && closed_after < Duration::from_secs(12), "{closed_after:?}");
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": scene("hermite-ruled.toml")}));
+    assert_eq!(a.status, 200, "{}", a.text());
+}
+
+/// The limits that had no test: a body over 1 MiB is 413 before it is read as JSON; a model
+/// over 2 000 000 vertices is 422 naming the editor's limit; `[::1]:PORT` is one of the
+/// loopback names answered, `[::1]` without the port is not.
+#[test]
+fn body_size_vertex_count_and_loopback_names() {
+    let (_k, addr) = start(&[]);
+    let port = addr.rsplit(':').next().unwrap();
+    let big = serde_json::json!({"text": format!("# {}\n{}", "x".repeat(1 << 20), scene("hermite-ruled.toml"))});
+    let a = post_json(&addr, "/api/model", &big);
+    assert_eq!(a.status, 413, "{}", a.text());
+    let huge = scene("klein-bottle.toml").replace("resolution = [161, 65]", "resolution = [1500, 1500]");
+    let a = post_json(&addr, "/api/model", &serde_json::json!({ "text": huge }));
+    assert_eq!(a.status, 422, "{}", a.text());
+    assert!(a.text().contains("2250000 vertices") && a.text().contains("limit is 2000000"), "{}", a.text());
+    let v6 = format!("[::1]:{port}");
+    assert_eq!(request(&addr, "GET", "/api/examples", &[("Host", &v6)], b"").status, 200);
+    assert_eq!(request(&addr, "GET", "/api/examples", &[("Host", "[::1]")], b"").status, 421);
 }

@@ -7,8 +7,11 @@ import { cam, sub, add, scl, dot, crs, nrm, eye, basis, matrices, mul4, project 
 import { canvas, gl, program, surf, flat, seamProg } from "/views.js";
 
 const S = window.pdeshape = {
-  frames: 0, vertexCount: 0, meshHash: "", lastError: null, diagnostics: null,
+  frames: 0, vertexCount: 0, lastError: null, diagnostics: null,
   lastDownload: null, requests: 0, header: null,
+  // the hash of the buffers as received, computed when first asked for
+  data: null, dataHash: null,
+  get meshHash() { return this.data ? (this.dataHash ??= wire.bytesHash(this.data)) : ""; },
 };
 const $ = (id) => document.getElementById(id);
 let scene = { name: "scene", text: "" };
@@ -386,7 +389,7 @@ async function solve(diagnostics) {
       const first = !model;
       if (edits === sent) { scene.text = header.text; edits = []; }
       model = { header, patches: upload(header, data) };
-      S.header = header; S.meshHash = header.hash;
+      S.header = header; S.data = data; S.dataHash = null;
       S.vertexCount = header.patches.reduce((a, p) => a + p.vertices, 0);
       // the diagnostics (and the seam markers from them) belong to the model they came with
       S.diagnostics = header.diagnostics || null;

@@ -20,9 +20,11 @@
 //! from the request's arrival, queueing included, and a solve past it is cancelled (the
 //! solvers' checkpoints unwind it) and holds its slot until it has really stopped.
 
+mod idle;
 mod wire;
 
 use crate::EXAMPLES;
+use crate::clip::{clip, printable};
 use anyhow::{Context, Result};
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State};
 use axum::http::{HeaderMap, StatusCode, header};
@@ -53,6 +55,12 @@ pub const MAX_VERTICES: usize = 2_000_000;
 pub const SOLVE_LIMIT: Duration = Duration::from_secs(30);
 /// Requests that may wait for a solve slot; more are refused with 429.
 pub const MAX_QUEUED: usize = 8;
+/// Downloads (`/api/export`) that may wait for the export slot; more are refused with 429.
+pub const MAX_QUEUED_EXPORTS: usize = 4;
+/// How long past the time limit a connection may stay silent (no byte read or written)
+/// before it is closed: no request takes longer than the limit, so a connection silent
+/// for longer is stalled.
+pub const IDLE_GRACE: Duration = Duration::from_secs(5);
 
 const PAGE: &str = include_str!("page.html");
 /// The editor's ES modules, by path: `app.js` imports the others.
@@ -77,18 +85,38 @@ pub struct ServeOptions {
     pub time_limit: Duration,
 }
 
-struct AppState {
-    initial: Option<(String, String)>,
-    /// One solve per core at a time; a solve holds its permit until it has stopped.
-    solves: Arc<Semaphore>,
+/// A kind of work with its own slots and queue: the editor's live requests, and the
+/// downloads (a STEP fit can take seconds), so that downloads never hold the slots or fill
+/// the queue that the sliders' requests need.
+struct Lane {
+    /// Work running at a time; a piece of work holds its permit until it has stopped.
+    slots: Arc<Semaphore>,
     /// Requests waiting for a permit.
     queued: AtomicUsize,
+    /// Most requests waiting; more are refused with 429.
+    max_queued: usize,
+    /// Worker threads of one piece of work.
+    threads: usize,
+    /// What the work is called in messages.
+    what: &'static str,
+}
+
+impl Lane {
+    fn new(slots: usize, max_queued: usize, threads: usize, what: &'static str) -> Lane {
+        Lane { slots: Arc::new(Semaphore::new(slots)), queued: AtomicUsize::new(0), max_queued, threads, what }
+    }
+}
+
+struct AppState {
+    initial: Option<(String, String)>,
+    /// Live requests (`/api/model`): one solve per core at a time, each parallel inside.
+    solves: Lane,
+    /// Downloads (`/api/export`): one at a time, on one thread.
+    exports: Lane,
     /// `Host` values answered (lower case): the bound `host:port`, loopback names.
     hosts: Vec<String>,
     limits: Limits,
     time_limit: Duration,
-    /// Worker threads of one solve.
-    threads: usize,
 }
 
 /// A request for the solved model.
@@ -243,6 +271,7 @@ pub fn run(o: ServeOptions) -> Result<()> {
         println!("pdeshape editor: http://{addr}/");
         use std::io::Write as _;
         std::io::stdout().flush().ok();
+        let listener = idle::IdleListener::new(listener, o.time_limit.saturating_add(IDLE_GRACE));
         axum::serve(listener, router(initial, addr, o.limits, o.time_limit)).await.context("server stopped")
     })
 }
@@ -272,12 +301,11 @@ pub fn router(
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
     let state = Arc::new(AppState {
         initial,
-        solves: Arc::new(Semaphore::new(threads)),
-        queued: AtomicUsize::new(0),
+        solves: Lane::new(threads, MAX_QUEUED, threads, "solve"),
+        exports: Lane::new(1, MAX_QUEUED_EXPORTS, 1, "export"),
         hosts: allowed_hosts(addr),
         limits,
         time_limit,
-        threads,
     });
     let mut router = Router::new().route("/", get(|| async { Html(PAGE) }));
     for (path, body) in SCRIPTS {
@@ -336,15 +364,6 @@ fn screen(hosts: &[String], h: &HeaderMap) -> Result<(), (StatusCode, String)> {
     Ok(())
 }
 
-/// At most `n` characters of `s`, with an ellipsis when cut (errors never echo a whole
-/// hostile input).
-fn clip(s: &str, n: usize) -> String {
-    match s.char_indices().nth(n) {
-        Some((i, _)) => format!("{}…", &s[..i]),
-        None => s.to_string(),
-    }
-}
-
 async fn initial_scene(State(s): State<Arc<AppState>>) -> Json<Value> {
     Json(match &s.initial {
         Some((name, text)) => json!({"name": name, "text": text}),
@@ -359,8 +378,10 @@ async fn example(UrlPath(name): UrlPath<String>) -> Response {
     }
 }
 
+/// An error answer; the message is escaped and cut (at most 2000 characters: errors
+/// never echo a whole hostile input).
 fn fail(code: StatusCode, msg: impl Into<String>) -> Response {
-    (code, Json(json!({"error": msg.into()}))).into_response()
+    (code, Json(json!({"error": printable(&msg.into(), 2000)}))).into_response()
 }
 
 /// Counts a waiting request while alive.
@@ -371,42 +392,53 @@ impl Drop for Queued<'_> {
     }
 }
 
-/// Runs `f` on the blocking pool under the queue, concurrency and time limits; the time
-/// counts from `arrived`. A solve past the limit is cancelled; its permit is released
-/// when it has stopped, not when the answer is sent.
+/// Runs `f` on the blocking pool under `lane`'s queue and slots and the time limit; the
+/// time counts from `arrived`. A request whose time runs out while it waits is refused as a
+/// queue time-out (it never started); work past the limit is cancelled, and its permit is
+/// released when it has stopped, not when the answer is sent.
 async fn limited<T: Send + 'static>(
     s: &AppState,
+    lane: &Lane,
     arrived: Instant,
     f: impl FnOnce() -> Result<T, String> + Send + 'static,
 ) -> Result<T, Response> {
     let deadline = tokio::time::Instant::from_std(arrived + s.time_limit);
-    let too_slow = |what: &str| {
-        fail(
-            StatusCode::SERVICE_UNAVAILABLE,
-            format!(
-                "{what} took longer than the editor's limit of {} s (lower the resolution, modes or order)",
-                s.time_limit.as_secs_f64()
-            ),
-        )
-    };
+    let limit = s.time_limit.as_secs_f64();
     let permit = {
-        let waiting = s.queued.fetch_add(1, Ordering::SeqCst);
-        let _q = Queued(&s.queued);
-        if waiting >= MAX_QUEUED {
+        let waiting = lane.queued.fetch_add(1, Ordering::SeqCst);
+        let _q = Queued(&lane.queued);
+        if waiting >= lane.max_queued {
             return Err(fail(
                 StatusCode::TOO_MANY_REQUESTS,
-                format!("the editor is busy: {waiting} requests are waiting for a solve; try again shortly"),
+                format!("the editor is busy: {waiting} requests are waiting for a {}; try again shortly", lane.what),
             ));
         }
-        match tokio::time::timeout_at(deadline, s.solves.clone().acquire_owned()).await {
-            Err(_) => return Err(too_slow("waiting for a free core")),
+        match tokio::time::timeout_at(deadline, lane.slots.clone().acquire_owned()).await {
+            Err(_) => {
+                return Err(fail(
+                    StatusCode::SERVICE_UNAVAILABLE,
+                    format!(
+                        "the request waited {limit} s in the queue for a free {} slot and was not started (the editor's time limit counts from arrival); try again shortly",
+                        lane.what
+                    ),
+                ));
+            }
             Ok(Err(_)) => return Err(fail(StatusCode::SERVICE_UNAVAILABLE, "shutting down")),
             Ok(Ok(p)) => p,
         }
     };
+    let too_slow = || {
+        fail(
+            StatusCode::SERVICE_UNAVAILABLE,
+            format!(
+                "the {} took longer than the editor's limit of {limit} s and was stopped (lower the resolution, modes or order)",
+                lane.what
+            ),
+        )
+    };
     let flag = Arc::new(AtomicBool::new(false));
     let worker_flag = flag.clone();
-    let threads = s.threads;
+    let threads = lane.threads;
     let mut task = tokio::task::spawn_blocking(move || {
         let _permit = permit; // held until the work has stopped
         cancel::run(&worker_flag, threads, f)
@@ -415,10 +447,10 @@ async fn limited<T: Send + 'static>(
         Err(_) => {
             // raise the flag: the solve unwinds at its next checkpoint and frees its core
             flag.store(true, Ordering::SeqCst);
-            Err(too_slow("the solve"))
+            Err(too_slow())
         }
-        Ok(Err(e)) => Err(fail(StatusCode::INTERNAL_SERVER_ERROR, format!("the solve failed: {e}"))),
-        Ok(Ok(Err(cancel::Cancelled))) => Err(too_slow("the solve")),
+        Ok(Err(e)) => Err(fail(StatusCode::INTERNAL_SERVER_ERROR, format!("the {} failed: {e}", lane.what))),
+        Ok(Ok(Err(cancel::Cancelled))) => Err(too_slow()),
         Ok(Ok(Ok(Err(e)))) => Err(fail(StatusCode::UNPROCESSABLE_ENTITY, e)),
         Ok(Ok(Ok(Ok(v)))) => Ok(v),
     }
@@ -464,12 +496,16 @@ async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelReques
     let arrived = Instant::now();
     let limits = s.limits;
     // diagnostics and encoding run inside the limits too
-    let r = limited(&s, arrived, move || {
+    let r = limited(&s, &s.solves, arrived, move || {
         let t0 = Instant::now();
         if let Some(c) = &req.curves {
             c.check()?;
         }
         let (scene, text, meshes) = solve(&req, &limits)?;
+        // the answer's buffers are f32: a value that does not fit is an error, not an inf
+        for m in &meshes {
+            m.check_fits_f32("the editor's buffers")?;
+        }
         let curves = req.curves.as_ref().map(|c| curves_answer(&scene, c));
         let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
         Ok(wire::encode(
@@ -501,7 +537,7 @@ async fn export_route(
     Json(req): Json<ModelRequest>,
 ) -> Response {
     let arrived = Instant::now();
-    let step = q.format == "step";
+    let step = q.format.eq_ignore_ascii_case("step") || q.format.eq_ignore_ascii_case("stp");
     let format = pdeshape_io::export::Format::from_extension(&q.format);
     if format.is_none() && !step {
         return fail(
@@ -511,14 +547,14 @@ async fn export_route(
     }
     let extension = format.map_or("step", |f| f.extension());
     let limits = s.limits;
-    let r = limited(&s, arrived, move || {
+    let r = limited(&s, &s.exports, arrived, move || {
         let (scene, _, meshes) = solve(&req, &limits)?;
         let bytes = match format {
             Some(format) => {
                 let refs: Vec<&Mesh> = meshes.iter().collect();
                 pdeshape_io::export::to_bytes(format, &refs).map_err(|e| e.to_string())?
             }
-            // certified B-spline faces at the editor's time (inside the time limit: the
+            // measured B-spline faces at the editor's time (inside the time limit: the
             // fit checks the cancel flag)
             None => {
                 let faces = pdeshape_io::cad::fit_scene(

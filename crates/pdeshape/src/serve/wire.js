@@ -9,6 +9,14 @@ export function decode(bytes) {
   return { header, data: bytes.slice(4 + n) };
 }
 
+// FNV-1a (32 bits, hex) of the buffers as received: what the tests compare, so that a
+// change is seen in the bytes that were drawn, not in a label the server sends with them.
+export function bytesHash(data) {
+  let h = 0x811c9dc5;
+  for (const b of new Uint8Array(data)) h = Math.imul(h ^ b, 0x01000193) >>> 0;
+  return h.toString(16).padStart(8, "0");
+}
+
 // A slice of f32 values (positions, normals, curves, fields).
 export const f32 = (data, slice) => new Float32Array(data, slice.offset, slice.count);
 
