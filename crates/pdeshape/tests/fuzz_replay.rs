@@ -12,7 +12,10 @@ fn inputs(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
     let mut out = Vec::new();
     for dir in ["seeds", "regressions"] {
-        let Ok(entries) = std::fs::read_dir(root.join(dir).join(target)) else { continue };
+        // both folders are tracked (`regressions/TARGET/.keep`): a missing one is a broken
+        // checkout or a renamed target, not "no inputs"
+        let path = root.join(dir).join(target);
+        let entries = std::fs::read_dir(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         for e in entries {
             let p = e.unwrap().path();
             if p.is_file() && !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')) {

@@ -67,7 +67,10 @@ fn torus_hyperboloid_blends_and_per_vertex_continuity_fields() {
     assert_eq!(names, ["c0_gap", "c1_gap", "g1_angle", "c2_gap", "g2_gap"]);
     assert!(m.fields.iter().all(|f| f.values.len() == m.positions.len() && f.values.iter().all(|x| *x < 1e-10)));
     let m = model::patch_mesh(&scene.patches[0]).unwrap();
-    assert!(m.fields[2].values.iter().fold(0.0f64, |a, b| a.max(*b)) > 0.1, "the 2nd-order blend creases");
+    assert!(
+        m.fields[2].values.iter().copied().fold(0.0f64, pdeshape_core::num::max_nan) > 0.1,
+        "the 2nd-order blend creases"
+    );
 }
 
 /// `--solver` overrides the scene: both solvers through `sample` agree on eigenfunction

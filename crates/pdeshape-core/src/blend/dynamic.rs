@@ -190,9 +190,10 @@ fn eigen_from(pts: impl Iterator<Item = FDerivs>) -> Option<(f64, f64)> {
     }
     let mu = pts.iter().map(|d| d.f * d.fvv).sum::<f64>() / den;
     let kappa = pts.iter().map(|d| d.f * d.ft).sum::<f64>() / den;
-    let scale = pts.iter().fold(0.0f64, |m, d| {
-        m.max(d.fvv.abs()).max(d.ft.abs()).max(d.ftt.abs()).max(d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa))
-    });
+    let scale = pts
+        .iter()
+        .flat_map(|d| [d.fvv.abs(), d.ft.abs(), d.ftt.abs(), d.f.abs() * (mu.abs() + kappa.abs() + kappa * kappa)])
+        .max_nan();
     let tol = 1e-11 * scale;
     pts.iter()
         .all(|d| {
@@ -579,7 +580,7 @@ impl DynamicBlend {
                         "the collocation matrix ({rows} × {cols}) at t = {t} is singular ({e}): use fewer sine terms or more points"
                     ))
                 })?;
-                cond = cond.max(c);
+                cond = crate::num::max_nan(cond, c);
                 x
             };
             for (gi, &j) in group.iter().enumerate() {

@@ -293,7 +293,7 @@ fn solve_exact(
                 c
             }
         };
-        cond = cond.max(card.condition_number());
+        cond = crate::num::max_nan(cond, card.condition_number());
         profiles.push(Profile::Exact { card, w: dec.coef.iter().map(|c| c[j]).collect() });
     }
     let rep = ComponentReport {

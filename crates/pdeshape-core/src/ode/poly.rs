@@ -114,7 +114,7 @@ pub fn polynomial_roots(c: &[f64]) -> Result<PolyRoots, OdeError> {
     if let Some(k) = c.iter().position(|x| !x.is_finite()) {
         return Err(bad(format!("coefficient {k} is not finite ({})", c[k])));
     }
-    let scale = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = c.iter().fold(0.0f64, |m, x| crate::num::max_nan(m, x.abs()));
     let Some(deg) = c.iter().rposition(|&x| x != 0.0) else {
         return Err(bad("every coefficient is zero (the operator vanishes)".into()));
     };
@@ -151,7 +151,7 @@ pub fn polynomial_roots(c: &[f64]) -> Result<PolyRoots, OdeError> {
         for zi in &mut z {
             newton(&q, zi);
         }
-        let rscale = z.iter().fold(0.0f64, |m, x| m.max(x.norm())).max(1e-300);
+        let rscale = crate::num::max_nan(z.iter().fold(0.0f64, |m, x| crate::num::max_nan(m, x.norm())), 1e-300);
         // Agglomerative clustering: the closest two groups within the tolerance merge when
         // the merged group is a genuine multiple root ([`multiple_root`]).
         let mut groups: Vec<(Vec<Complex64>, Complex64)> = z.iter().map(|&x| (vec![x], x)).collect();
@@ -173,7 +173,7 @@ pub fn polynomial_roots(c: &[f64]) -> Result<PolyRoots, OdeError> {
             match multiple_root(&q, &members) {
                 Some(root) => {
                     for m in &members {
-                        merged = merged.max((m - root).norm() / rscale);
+                        merged = crate::num::max_nan(merged, (m - root).norm() / rscale);
                     }
                     groups[j] = (members, root);
                     groups.remove(i);

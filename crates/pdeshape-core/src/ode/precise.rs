@@ -366,7 +366,7 @@ mod tests {
             for (k, cd) in conds.iter().enumerate() {
                 let v = l.eval(cd.u, 0);
                 for (i, x) in v[0].iter().enumerate() {
-                    err = err.max((x - if i == k { 1.0 } else { 0.0 }).abs());
+                    err = crate::num::max_nan(err, (x - if i == k { 1.0 } else { 0.0 }).abs());
                 }
             }
             assert!(err < 1e-12, "c = {c}: cardinal error {err:e} at {} bits", l.bits());

@@ -161,7 +161,7 @@ impl SolidBlend {
             Trial::Galerkin => s.solve_separated(true)?,
             Trial::Paper | Trial::Collocation => s.solve_collocation()?,
         }
-        s.report.max_coefficient = s.a.iter().map(|x| x.x.abs().max(x.y.abs()).max(x.z.abs())).max_nan();
+        s.report.max_coefficient = s.a.iter().map(|x| x.max_abs()).max_nan();
         Ok(s)
     }
 
@@ -247,12 +247,12 @@ impl SolidBlend {
                     let b = t.transpose() * &rhs;
                     let solver =
                         crate::linalg::SquareSolver::new(&a, 1e14).map_err(|e| SolidError::Solve(e.to_string()))?;
-                    cond = cond.max(solver.cond());
+                    cond = crate::num::max_nan(cond, solver.cond());
                     solver.solve(&b)
                 } else {
                     let (x, c) =
                         crate::linalg::least_squares(&g, &rhs, 1e14).map_err(|e| SolidError::Solve(e.to_string()))?;
-                    cond = cond.max(c);
+                    cond = crate::num::max_nan(cond, c);
                     x
                 };
                 for n in 0..nn {

@@ -24,7 +24,9 @@ impl MassProperties {
     /// True when `det J` changes sign or vanishes (the solid folds over itself); a
     /// uniformly negative `det J` is only a reversed orientation.
     pub fn folds(&self) -> bool {
-        self.min_jacobian <= 0.0 && self.max_jacobian >= 0.0
+        // NaN (a Jacobian that could not be evaluated) counts as a fold: nothing shows
+        // that the map is one-to-one there
+        !(self.min_jacobian > 0.0 || self.max_jacobian < 0.0)
     }
 }
 
@@ -53,8 +55,9 @@ impl SolidBlend {
         for &(p, j, q) in &samples {
             vol += q * j.abs();
             first += p * (q * j.abs());
-            jmin = jmin.min(j);
-            jmax = jmax.max(j);
+            // a NaN Jacobian makes both NaN, and `folds` then reports a fold
+            jmin = crate::num::min_nan(jmin, j);
+            jmax = crate::num::max_nan(jmax, j);
         }
         let c = first / vol;
         let mut inertia = [[0.0; 3]; 3];

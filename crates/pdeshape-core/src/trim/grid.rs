@@ -160,7 +160,7 @@ fn winslow_sweep(p: &mut [Uv], rings: usize, cols: usize) -> f64 {
                 let mixed = ne[d] - se[d] - nw[d] + sw[d];
                 new[d] = (alpha * (e[d] + w[d]) + gamma * (n[d] + s[d]) - 0.5 * beta * mixed) / den;
             }
-            moved = moved.max((new[0] - old[0]).abs().max((new[1] - old[1]).abs()));
+            moved = crate::num::max_nan(moved, crate::num::max_nan((new[0] - old[0]).abs(), (new[1] - old[1]).abs()));
             p[k] = new;
         }
     }
@@ -345,7 +345,7 @@ fn best_position(p: &[Uv], cols: usize, reflex: &[Option<Uv>], i: usize, j: usiz
         let t = sub(x0, at(0, j));
         f.push(([scale * n[0], scale * n[1]], scale * (t[0] * n[0] + t[1] * n[1])));
     }
-    let worst = |d: Uv| f.iter().map(|(g, c)| g[0] * d[0] + g[1] * d[1] + c).fold(f64::INFINITY, f64::min);
+    let worst = |d: Uv| f.iter().map(|(g, c)| g[0] * d[0] + g[1] * d[1] + c).fold(f64::INFINITY, crate::num::min_nan);
     let (mut best, mut best_d) = (worst([0.0, 0.0]), [0.0, 0.0]);
     for a in 0..f.len() {
         for b in a + 1..f.len() {
@@ -424,15 +424,15 @@ fn quality(map: &LaplaceMap, p: &[Uv], rings: usize, cols: usize) -> TrimReport 
             let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
             let area = 0.5 * (cross(sub(q[2], q[0]), sub(q[3], q[1]))).abs();
             total += area;
-            cmin = cmin.min(area);
-            cmax = cmax.max(area);
+            cmin = crate::num::min_nan(cmin, area);
+            cmax = crate::num::max_nan(cmax, area);
             for k in 0..4 {
                 let (a, b, c) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
                 let (x, y) = (sub(a, b), sub(c, b));
                 let ang = cross(y, x).atan2(x[0] * y[0] + x[1] * y[1]).abs().to_degrees();
                 if x != [0.0, 0.0] && y != [0.0, 0.0] {
-                    amin = amin.min(ang);
-                    amax = amax.max(ang);
+                    amin = crate::num::min_nan(amin, ang);
+                    amax = crate::num::max_nan(amax, ang);
                 }
             }
         }
