@@ -22,9 +22,10 @@ fn sphere_holes_are_filled_with_exact_g1() {
         let f = &d["fill"];
         // the normal is the cross product of two exactly met conditions (position and cross
         // tangent, both in the sphere's tangent plane): round-off, a few 1e-16 … 1e-15
+        // (measured ≤ 1.9e-15 rad, gaps ≤ 5.6e-16); 1e-13 leaves room for other libms
         let (g1, gap) = (f["g1_max_radians"].as_f64().unwrap(), f["gap_max_relative"].as_f64().unwrap());
         assert!(f["edge_samples"].as_u64().unwrap() >= 1000);
-        assert!(g1 <= 1e-9 && gap <= 1e-12, "{name}: G1 {g1}, gap {gap}");
+        assert!(g1 <= 1e-13 && gap <= 1e-14, "{name}: G1 {g1}, gap {gap}");
         assert_eq!(f["folds"], 0, "{name}");
         assert_eq!(d["continuity"]["class"], "G1", "{name}: {}", d["continuity"]);
         assert!(d["condition_error"]["max_rel"].as_f64().unwrap() <= 1e-13);
@@ -66,7 +67,8 @@ fn box_corner_is_filled_with_exact_g1_near_the_sphere_octant() {
     let d = model::patch_diagnostics(p).to_json();
     let f = &d["fill"];
     let (g1, gap) = (f["g1_max_radians"].as_f64().unwrap(), f["gap_max_relative"].as_f64().unwrap());
-    assert!(g1 <= 1e-9 && gap <= 1e-12, "G1 {g1}, gap {gap}");
+    // round-off, as for the sphere holes (measured 1.6e-15 rad, gap 7.6e-16)
+    assert!(g1 <= 1e-13 && gap <= 1e-14, "G1 {g1}, gap {gap}");
     assert_eq!(f["folds"], 0);
     for a in f["corner_normal_angles_radians"].as_array().unwrap() {
         assert!(a.as_f64().unwrap() < 1e-12, "the fillets meet G1 at the corners: {a}");
@@ -133,10 +135,10 @@ fn wing_root_is_filled_with_exact_g2() {
     assert_eq!(f["order"], 6);
     let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
     let (g1, gap, g2) = (get("g1_max_radians"), get("gap_max_relative"), get("g2_max_relative"));
-    // G1 and gap: round-off of exactly met conditions (~1e-14 here: the patch's second
-    // cardinal functions and the fillets' quintics carry a little more than order 4);
-    // G2: the 1e-8 (measured ~1e-12)
-    assert!(g1 <= 1e-9 && gap <= 1e-12 && g2 <= 1e-8, "G1 {g1}, gap {gap}, G2 {g2}");
+    // G1 and gap: round-off of exactly met conditions (measured 5.1e-14 rad, gap 1.4e-14:
+    // the patch's second cardinal functions and the fillets' quintics carry a little more
+    // than order 4); G2 measured 4.6e-13
+    assert!(g1 <= 1e-12 && gap <= 1e-13 && g2 <= 1e-11, "G1 {g1}, gap {gap}, G2 {g2}");
     assert!(f["edge_samples"].as_u64().unwrap() >= 1000);
     assert_eq!(f["folds"], 0);
     for (a, c) in f["corner_normal_angles_radians"]
@@ -223,7 +225,8 @@ fn a_trim_hole_is_plugged_with_g2() {
     let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
     let (g1, gap, g2) = (get("g1_max_radians"), get("gap_max_relative"), get("g2_max_relative"));
     eprintln!("dolphin dorsal plug: G1 {g1:.1e} rad, gap {gap:.1e}, G2 {g2:.1e}");
-    assert!(g1 <= 1e-9 && gap <= 1e-12 && g2 <= 1e-8, "G1 {g1}, gap {gap}, G2 {g2}");
+    // round-off (measured G1 1.9e-14 rad, gap 9.4e-15, G2 9.3e-14)
+    assert!(g1 <= 1e-12 && gap <= 1e-13 && g2 <= 1e-11, "G1 {g1}, gap {gap}, G2 {g2}");
     assert_eq!(f["folds"], 0);
     // the corners lie on one smooth surface: no mismatch of planes or curvatures
     for k in ["corner_normal_angles_radians", "corner_curvature_gaps_relative"] {

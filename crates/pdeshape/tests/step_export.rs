@@ -327,7 +327,14 @@ fn degree_five_keeps_curvature_across_c2_seams() {
     assert!(gap(&quintic, "o6") < 1e-10, "{}", gap(&quintic, "o6"));
     assert!(gap(&quintic, "o4") > 0.1, "{}", gap(&quintic, "o4"));
     for s in &quintic {
-        assert!(s["normal_angle_radians"].as_f64().unwrap() < 1.0, "{s}");
+        let (face, angle) = (s["faces"][0].as_str().unwrap(), s["normal_angle_radians"].as_f64().unwrap());
+        if face.starts_with("o2") {
+            // second-order blends are C0: they crease at their seams (0.18 … 0.43 rad)
+            assert!(angle > 0.1, "{s}");
+        } else {
+            // C1 blends: round-off of the fitted faces' first derivatives (measured ≤ 1.8e-14)
+            assert!(angle <= 1e-12, "{s}");
+        }
     }
     let dir = tempfile::tempdir().unwrap();
     let o = build(&example("bloor-wilson-blend.toml"), &dir.path().join("x.step"), &["--degree", "4"]);

@@ -322,7 +322,8 @@ fn self_crossing(pts: &[Vec3], tol: f64) -> Option<(usize, usize, Vec3)> {
             }
             for i in ra * RUN..((ra + 1) * RUN).min(m) {
                 for j in (rb * RUN).max(i + 2)..((rb + 1) * RUN).min(m) {
-                    if !(apart(i, j) >= 4.0 * tol) {
+                    // NaN lengths count as far apart: the pair is compared
+                    if apart(i, j) < 4.0 * tol {
                         continue;
                     }
                     let (d, p) = segment_distance(pts[i], pts[(i + 1) % m], pts[j], pts[(j + 1) % m]);
@@ -583,7 +584,7 @@ impl Fill {
         }
         if let Some(p) = o.pole {
             let d = (p - centroid).scaled_norm();
-            if !(d <= 1e6 * radius) {
+            if d.is_nan() || d > 1e6 * radius {
                 return Err(FillError::Loop(format!(
                     "the pole {p} is {d:.3e} from the loop's centroid, more than 1e6 × the loop's mean radius {radius:.3e}"
                 )));
@@ -852,18 +853,18 @@ impl Fill {
             if step == 0.0 { 0.0 } else { step / (h * crate::num::max_nan(a[k].norm(), b[k].norm())) }
         };
         let (mut worst, mut place) = (0.0, (0.0, 0.0));
-        for i in 0..nu {
-            for j in 0..nv {
+        for (i, &u) in us.iter().enumerate() {
+            for (j, &v) in vs.iter().enumerate() {
                 let p = at(i, j);
                 let mut r = ratio(p, at(i, j + 1), 2, hv);
                 if i + 1 < nu {
                     r = crate::num::max_nan(r, ratio(p, at(i + 1, j), 1, hu));
                 }
                 if r.is_nan() {
-                    return (f64::NAN, (us[i], vs[j]));
+                    return (f64::NAN, (u, v));
                 }
                 if r > worst {
-                    (worst, place) = (r, (us[i], vs[j]));
+                    (worst, place) = (r, (u, v));
                 }
             }
         }

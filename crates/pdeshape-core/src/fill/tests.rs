@@ -55,7 +55,7 @@ fn sphere_holes_are_filled_with_exact_g1() {
         let c = fill.edge_continuity(400);
         // G1: the normal is a cross product of exactly met conditions; round-off of the
         // data and the patch (~1e-15) over lengths ~ 1 gives angles of a few 1e-15
-        assert!(c.g1 <= 1e-9, "{n}-gon: G1 angle {}", c.g1);
+        assert!(c.g1 <= 1e-13, "{n}-gon: G1 angle {}", c.g1);
         assert!(c.gap <= 1e-12, "{n}-gon: gap {}", c.gap);
         assert!(fill.report().corner_angles.iter().all(|a| *a < 1e-12), "{:?}", fill.report().corner_angles);
         assert_eq!(fill.folds(41, 200), 0, "{n}-gon folds");
@@ -105,13 +105,16 @@ fn long_loops_short_edges_and_point_edges_are_filled() {
         let c = fill.edge_continuity(4 * n);
         assert_eq!(fill.report().corner_angles.len(), n);
         // G1 by construction; the same bound as the few-edge holes
-        assert!(c.g1 <= 1e-9, "{n} edges: G1 {}", c.g1);
+        assert!(c.g1 <= 1e-13, "{n} edges: G1 {}", c.g1);
     }
     // a pentagon with one vertex split into two 1e-3 apart (an edge of 1e-3 of the radius)
     let pi2 = std::f64::consts::TAU;
     let az = [0.0, 1e-3, 0.2 * pi2, 0.4 * pi2, 0.6 * pi2, 0.8 * pi2];
     let fill = Fill::new(&sphere_loop(&az, theta), &FillOptions::default()).unwrap();
-    assert!(fill.edge_continuity(600).g1 <= 1e-9);
+    let g1 = fill.edge_continuity(600).g1;
+    // the short edge's tangent X_v is 1e-3 of the others', and the round-off of the normal
+    // X_u × X_v grows by that ratio there (measured 4.5e-13)
+    assert!(g1 <= 1e-11, "a 1e-3 edge: G1 {g1}");
     // an edge that is one point (w from 0 to 0) between edges 1 and 2 is dropped
     let mut e = sphere_hole(5, theta);
     let mut point = e[2].clone();
@@ -175,7 +178,7 @@ fn sphere_holes_are_filled_with_exact_g2_at_order_6() {
         // G1 and gap as at order 4; G2: second derivatives of data and patch carry
         // round-off ~1e-14 relative (the remainder's second-derivative cardinal function
         // and the data's jets), far below the 1e-8
-        assert!(c.g1 <= 1e-9, "{n}-gon: G1 angle {}", c.g1);
+        assert!(c.g1 <= 1e-13, "{n}-gon: G1 angle {}", c.g1);
         assert!(c.gap <= 1e-12, "{n}-gon: gap {}", c.gap);
         assert!(c.g2 <= 1e-8, "{n}-gon: G2 gap {}", c.g2);
         let r = fill.report();

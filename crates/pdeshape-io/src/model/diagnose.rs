@@ -333,7 +333,7 @@ fn fill_report(f: &pdeshape_core::fill::Fill, warnings: &mut Vec<String>) -> Fil
         }
     }
     let (tear, (tu, tv)) = f.tear(41, 4000);
-    if !(tear <= TEAR_WARNING) {
+    if tear.is_nan() || tear > TEAR_WARNING {
         warnings.push(format!(
             "the fill jumps near (u, v) = ({tu:.4}, {tv:.4}): a step between neighbouring points is {tear:.3e} × what its derivatives allow; the loop's data are not continuous there"
         ));

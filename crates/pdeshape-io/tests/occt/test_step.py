@@ -144,7 +144,12 @@ def test_step_reads_back_valid_and_within_the_tolerance(name, tmp_path):
             assert not np.isnan(d_param)
             worst = max(worst, d_param)
             if k % 10 == 0:
-                proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*map(float, x)), surf)
+                # OCCT's projection, searched within 5 % of the ranges around (u, v): over
+                # the whole surface its extremum search can settle on the far side of a
+                # thin face (the wing at its trailing edge: 1.2e-4 found, 6.4e-8 at (u, v))
+                du, dv = 0.05 * (u1 - u0), 0.05 * (v1 - v0)
+                box = (max(u0, u - du), min(u1, u + du), max(v0, v - dv), min(v1, v + dv))
+                proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*map(float, x)), surf, *map(float, box), 1e-12)
                 assert proj.NbPoints() > 0
                 assert proj.LowerDistance() <= d_param + 1e-12
         # the measured maximum agrees with random points (the
@@ -187,7 +192,7 @@ def normals(face, u, vs):
 def test_a_c1_blend_stays_g1_with_its_surfaces_after_export(name, patch, u, surface, su, tmp_path):
     """The blend's edge and its primary surface's edge share v knots and interpolate the
     same position and (parallel) cross derivatives, so the faces OCCT reads meet G1: the
-    normal lines' angle at 200 points along the seam, computed by OCCT, is ≤ 1e-5 rad."""
+    normal lines' angle at 200 points along the seam, computed by OCCT, is ≤ 1e-12 rad."""
     path, fits = build(name, tmp_path)
     shape = read(path)
     # the blend and its two surfaces share their seam edges: one connected shell
@@ -198,7 +203,9 @@ def test_a_c1_blend_stays_g1_with_its_surfaces_after_export(name, patch, u, surf
     na, nb = normals(fs[patch], u, vs), normals(fs[surface], su, vs)
     angle = np.arcsin(np.clip(np.linalg.norm(np.cross(na, nb), axis=1), 0, 1))
     assert np.isfinite(angle).all()
-    assert angle.max() <= 1e-5, angle.max()
+    print(f"{name} {patch}-{surface}: largest normal-line angle {angle.max():.2e} rad")
+    # OCCT's own normals of the read faces: round-off (measured 4.2e-15 … 1.4e-14)
+    assert angle.max() <= 1e-12, angle.max()
     pa = np.array([[p.X(), p.Y(), p.Z()] for p in (BRep_Tool.Surface_s(fs[patch]).Value(u, float(v)) for v in vs)])
     pb = np.array([[p.X(), p.Y(), p.Z()] for p in (BRep_Tool.Surface_s(fs[surface]).Value(su, float(v)) for v in vs)])
     assert np.linalg.norm(pa - pb, axis=1).max() <= 1e-12 * (1 + np.abs(pa).max())
