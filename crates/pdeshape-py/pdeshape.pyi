@@ -60,12 +60,27 @@ class Scene:
 
     @staticmethod
     def load(
-        path: Union[str, PathLike], *, solver: Optional[str] = None, terms: Optional[int] = None, **params: float
-    ) -> Scene: ...
+        path: Union[str, PathLike],
+        *,
+        solver: Optional[str] = None,
+        terms: Optional[int] = None,
+        limits: Optional[Dict[str, int]] = None,
+        **params: float,
+    ) -> Scene:
+        """Loads and solves a scene file; `limits` sets caps as the CLI's `--limit` does
+        (order, modes, collocation, vertices, memory and scene in MiB); the memory cap also
+        bounds the arrays that `evaluate` and `derivatives` return (MemoryError)."""
     @staticmethod
     def from_toml(
-        text: str, name: str = "scene", *, solver: Optional[str] = None, terms: Optional[int] = None, **params: float
-    ) -> Scene: ...
+        text: str,
+        name: str = "scene",
+        *,
+        solver: Optional[str] = None,
+        terms: Optional[int] = None,
+        limits: Optional[Dict[str, int]] = None,
+        **params: float,
+    ) -> Scene:
+        """Parses and solves scene text, held to the `scene` cap (16 MiB by default)."""
     def set(self, **values: float) -> Scene:
         """A new scene with parameters changed, solved again."""
     @property

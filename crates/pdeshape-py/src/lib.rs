@@ -9,14 +9,14 @@
 use numpy::ndarray::{Array1, Array2, Array4, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray2, PyUntypedArrayMethods};
 use pdeshape_core::Vec3;
-use pdeshape_core::limits::Limits;
+use pdeshape_core::limits::{Cap, Limits};
 use pdeshape_core::mesh::Mesh as CoreMesh;
 use pdeshape_core::patch::Surface;
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::sample::{Target, points_into};
 use pdeshape_io::scene::{LoadOptions, Scene as IoScene, SceneError as IoSceneError, ScenePatch};
-use pyo3::exceptions::{PyException, PyKeyError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyError, PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;
@@ -35,9 +35,28 @@ pyo3::create_exception!(
      `e.column` (1-based, or None) and `e.key` (dotted key path) give the place."
 );
 
-fn scene_error(e: IoSceneError) -> PyErr {
+/// A message as Python users read it: the CLI's advice "raise the cap with `--limit
+/// NAME=VALUE` (library: `Limits::NAME`)" becomes "pass `limits={'NAME': VALUE}`".
+fn py_message(s: &str) -> String {
+    const CLI: &str = "raise the cap with `--limit ";
+    let Some(k) = s.find(CLI) else { return s.to_string() };
+    let rest = &s[k + CLI.len()..];
+    let Some(end) = rest.find('`') else { return s.to_string() };
+    let Some((name, value)) = rest[..end].split_once('=') else { return s.to_string() };
+    let mut tail = &rest[end + 1..];
+    if let Some(t) = tail.strip_prefix(" (library: `Limits::") {
+        tail = t.find("`)").map_or(tail, |i| &t[i + 2..]);
+    }
+    format!(
+        "{}raise the cap with `limits={{'{name}': {value}}}` (a keyword of Scene.load and Scene.from_toml){tail}",
+        &s[..k]
+    )
+}
+
+fn scene_error(mut e: IoSceneError) -> PyErr {
+    e.message = py_message(&e.message);
     Python::attach(|py| {
-        let err = SceneError::new_err(e.to_string());
+        let err = SceneError::new_err(py_message(&e.to_string()));
         let v = err.value(py);
         let set = |k: &str, x: Py<PyAny>| v.setattr(k, x).expect("exception attributes are settable");
         set("file", e.file.clone().into_pyobject(py).expect("str").into_any().unbind());
@@ -72,9 +91,21 @@ impl Scene {
     fn options(
         solver: Option<String>,
         terms: Option<usize>,
+        limits: Option<&Bound<'_, PyDict>>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<LoadOptions> {
         let mut opts = LoadOptions { solver, terms, limits: Limits::default(), ..Default::default() };
+        if let Some(l) = limits {
+            for (k, v) in l.iter() {
+                let name: String =
+                    k.extract().map_err(|_| PyTypeError::new_err("limits: the keys are cap names (str)"))?;
+                let cap: Cap = name.parse().map_err(|e: String| PyValueError::new_err(format!("limits: {e}")))?;
+                let value: usize = v
+                    .extract()
+                    .map_err(|_| PyTypeError::new_err(format!("limits['{name}']: expected a non-negative integer")))?;
+                opts.limits.set(cap, value);
+            }
+        }
         if let Some(p) = params {
             for (k, v) in p.iter() {
                 let name: String = k.extract()?;
@@ -94,34 +125,43 @@ impl Scene {
 impl Scene {
     /// Loads and solves a scene file. Keyword arguments override parameters
     /// (`Scene.load(path, a=1.37)`); `solver` ("auto", "exact", "collocation") and `terms`
-    /// override blends' solvers as the CLI's `--solver` and `--terms` do.
+    /// override blends' solvers as the CLI's `--solver` and `--terms` do; `limits` sets caps
+    /// as the CLI's `--limit` does (`limits={"memory": 1024, "modes": 1024}`; names: order,
+    /// modes, collocation, vertices, memory in MiB, scene in MiB). The memory cap also
+    /// bounds the arrays `evaluate` and `derivatives` return.
     #[staticmethod]
-    #[pyo3(signature = (path, *, solver=None, terms=None, **params))]
+    #[pyo3(signature = (path, *, solver=None, terms=None, limits=None, **params))]
     fn load(
         py: Python<'_>,
         path: std::path::PathBuf,
         solver: Option<String>,
         terms: Option<usize>,
+        limits: Option<&Bound<'_, PyDict>>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
-        let opts = Scene::options(solver, terms, params)?;
+        let opts = Scene::options(solver, terms, limits, params)?;
         let text = pdeshape_io::scene::read_scene_file(&path, &opts.limits).map_err(scene_error)?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
         Scene::build(&text, &path.display().to_string(), &name, opts, py)
     }
 
-    /// Parses and solves scene text (TOML); `name` labels errors and exports.
+    /// Parses and solves scene text (TOML); `name` labels errors and exports. The text is
+    /// held to the `scene` cap as files are (16 MiB unless `limits` says otherwise).
     #[staticmethod]
-    #[pyo3(signature = (text, name="scene", *, solver=None, terms=None, **params))]
+    #[pyo3(signature = (text, name="scene", *, solver=None, terms=None, limits=None, **params))]
     fn from_toml(
         py: Python<'_>,
         text: &str,
         name: &str,
         solver: Option<String>,
         terms: Option<usize>,
+        limits: Option<&Bound<'_, PyDict>>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
-        let opts = Scene::options(solver, terms, params)?;
+        let opts = Scene::options(solver, terms, limits, params)?;
+        opts.limits
+            .check(Cap::Scene, (text.len() as u128).div_ceil(1 << 20), "the scene text's size")
+            .map_err(|e| SceneError::new_err(py_message(&format!("{name}: {e}"))))?;
         Scene::build(text, name, name, opts, py)
     }
 
@@ -129,7 +169,7 @@ impl Scene {
     #[pyo3(signature = (**values))]
     fn set(&self, py: Python<'_>, values: Option<&Bound<'_, PyDict>>) -> PyResult<Scene> {
         let mut opts = self.opts.clone();
-        opts.params.extend(Scene::options(None, None, values)?.params);
+        opts.params.extend(Scene::options(None, None, None, values)?.params);
         let s = &self.inner;
         Scene::build(&s.source, &s.file, &s.name, opts, py)
     }
@@ -238,6 +278,24 @@ struct Patch {
 impl Patch {
     fn get(&self) -> &ScenePatch {
         &self.scene.patches[self.index]
+    }
+
+    /// A zeroed buffer of `n` f64 for an output array: held to the scene's `memory` cap,
+    /// then allocated fallibly, so a request too large for the cap or the machine raises
+    /// `MemoryError` instead of aborting the interpreter.
+    fn buffer(&self, n: u128, what: &str) -> PyResult<Vec<f64>> {
+        let bytes = n.saturating_mul(8);
+        self.scene
+            .options
+            .limits
+            .check_bytes(bytes, what)
+            .map_err(|e| PyMemoryError::new_err(py_message(&e.to_string())))?;
+        let n = usize::try_from(n).map_err(|_| PyMemoryError::new_err(format!("{what}: {n} values")))?;
+        let mut v = Vec::new();
+        v.try_reserve_exact(n)
+            .map_err(|_| PyMemoryError::new_err(format!("{what}: cannot allocate {:.3e} bytes", bytes as f64)))?;
+        v.resize(n, 0.0);
+        Ok(v)
     }
 
     /// The surface at time `t` (dynamic blends; an error for `t` on other kinds).
@@ -353,12 +411,16 @@ impl Patch {
             None => Target::of(self.get()),
         };
         let n = a.nrows();
+        let mut out = self.buffer(3 * n as u128, "the array of points")?;
         let params: Cow<'_, [f64]> = match a.as_slice() {
             Some(s) => Cow::Borrowed(s),
-            None => Cow::Owned(a.iter().copied().collect()),
+            None => {
+                let mut c = self.buffer(a.len() as u128, "a contiguous copy of the parameters")?;
+                c.iter_mut().zip(a.iter()).for_each(|(d, s)| *d = *s);
+                Cow::Owned(c)
+            }
         };
         let out = py.detach(|| {
-            let mut out = vec![0.0; 3 * n];
             points_into(target, &params, &mut out);
             out
         });
@@ -391,8 +453,8 @@ impl Patch {
         let s = self.surface(t)?;
         let n = a.nrows();
         let per = (du + 1) * (dv + 1) * 3;
+        let mut out = self.buffer(n as u128 * per as u128, "the array of derivatives")?;
         let out = py.detach(|| {
-            let mut out = vec![0.0; n * per];
             for (dst, row) in out.chunks_mut(per).zip(a.outer_iter()) {
                 for (k, d) in s.derivatives(row[0], row[1], du, dv).iter().enumerate() {
                     dst[3 * k..3 * k + 3].copy_from_slice(&[d.x, d.y, d.z]);
@@ -416,9 +478,9 @@ impl Patch {
                     p.kind.name()
                 )));
             }
-            if !t.is_finite() {
-                return Err(PyValueError::new_err(format!("t = {t} is not finite")));
-            }
+            // the frame is solved (and kept) here, so a time the blend refuses raises as
+            // it does in `evaluate` (t = 1e308 was meshed)
+            self.surface(Some(t))?;
         }
         if let Some((nu, nv)) = resolution {
             if p.trim.is_some() || p.solid.is_some() {
@@ -430,9 +492,11 @@ impl Patch {
             if nu < 2 || nv < 2 {
                 return Err(PyValueError::new_err(format!("resolution ({nu}, {nv}): at least 2 × 2")));
             }
-            Limits::default()
-                .check(pdeshape_core::limits::Cap::Vertices, (nu as u128) * (nv as u128), "the mesh's vertices")
-                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            self.scene
+                .options
+                .limits
+                .check(Cap::Vertices, (nu as u128) * (nv as u128), "the mesh's vertices")
+                .map_err(|e| PyValueError::new_err(py_message(&e.to_string())))?;
             p.resolution = (nu, nv);
         }
         let m = py.detach(|| model::patch_mesh_at(&p, t)).map_err(PyRuntimeError::new_err)?;

@@ -155,6 +155,83 @@ def test_export_writes_what_build_writes(tmp_path):
     assert not (tmp_path / "x.nope").exists()
 
 
+def test_export_writes_into_a_fifo_without_replacing_it(tmp_path):
+    """An existing FIFO is written into (its reader gets the file) and stays a FIFO; the
+    atomic rename used to put a regular file in its place."""
+    import stat
+    import threading
+
+    fifo = tmp_path / "pipe.obj"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()))
+    reader.start()
+    pdeshape.Scene.load(ROOT / "examples/hermite-ruled.toml").export(fifo)
+    reader.join(timeout=60)
+    assert not reader.is_alive()
+    assert got and got[0].startswith(b"# ") and b"\nv " in got[0], got[0][:40]
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+MEMORY_CHILD = """
+import resource, sys
+import numpy as np
+import pdeshape
+resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+patch = pdeshape.Scene.load(sys.argv[1]).patches[0]
+uv = np.zeros((10_000_000, 2))
+uv[:, 0] = 0.5
+try:
+    patch.derivatives(uv, 2, 4)  # 3.6 GB of output
+except MemoryError as e:
+    print("MemoryError:", e)
+"""
+
+
+def test_an_output_too_large_for_the_machine_raises_memory_error():
+    """Under a 3 GiB address-space limit, 10^7 rows of derivatives up to (2, 4) (3.6 GB)
+    killed the interpreter with SIGABRT; now they raise MemoryError."""
+    r = subprocess.run(
+        [os.sys.executable, "-c", MEMORY_CHILD, str(ROOT / "examples/hermite-ruled.toml")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, (r.returncode, r.stderr[-2000:])
+    assert "MemoryError: the array of derivatives: cannot allocate" in r.stdout, (r.stdout, r.stderr[-2000:])
+
+
+def test_the_memory_cap_bounds_output_arrays_and_caps_are_set_from_python():
+    scene = pdeshape.Scene.load(ROOT / "examples/hermite-ruled.toml", limits={"memory": 1})
+    patch = scene.patches[0]
+    assert patch.evaluate(np.full((40_000, 2), 0.5)).shape == (40_000, 3)  # 0.9 MiB
+    with pytest.raises(MemoryError) as e:
+        patch.evaluate(np.full((50_000, 2), 0.5))  # 1.1 MiB
+    msg = str(e.value)
+    assert "limits={'memory': 2}" in msg and "--limit" not in msg, msg
+    with pytest.raises(ValueError, match="unknown cap"):
+        pdeshape.Scene.load(ROOT / "examples/hermite-ruled.toml", limits={"nope": 1})
+    # from_toml's text is held to the scene cap like a file (it took 20 MB); 17 MiB and a
+    # scene are 18 MiB rounded up
+    text = (ROOT / "examples/hermite-ruled.toml").read_text() + "#" * (17 << 20) + "\n"
+    with pytest.raises(pdeshape.SceneError) as e:
+        pdeshape.Scene.from_toml(text)
+    assert "limits={'scene': 18}" in str(e.value) and "--limit" not in str(e.value), str(e.value)
+    # a cap hit while loading is worded for Python too
+    with pytest.raises(pdeshape.SceneError) as e:
+        pdeshape.Scene.load(ROOT / "examples/klein-bottle.toml", limits={"modes": 2})
+    assert "limits={'modes': 6}" in str(e.value) and "--limit" not in str(e.value), str(e.value)
+
+
+def test_a_time_outside_a_dynamic_blend_raises_in_mesh_as_in_evaluate():
+    patch = pdeshape.Scene.load(ROOT / "examples/dynamic-linear.toml").patches[0]
+    with pytest.raises(RuntimeError) as e1:
+        patch.evaluate(np.array([[0.5, 0.0]]), t=1e308)
+    with pytest.raises(RuntimeError) as e2:
+        patch.mesh(t=1e308)
+    assert str(e1.value) == str(e2.value)
+
+
 def test_bad_scenes_raise_with_the_place():
     text = '[patches.p]\nkind = "hermite"\nconditions = [\n  { u = 0, curve = "nope" },\n]\n'
     with pytest.raises(pdeshape.SceneError) as e:
