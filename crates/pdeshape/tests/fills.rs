@@ -15,7 +15,8 @@ fn example(name: &str) -> PathBuf {
 
 #[test]
 fn sphere_holes_are_filled_with_exact_g1() {
-    for (name, occt_g1) in [("triangle", 2.7e-3), ("pentagon", 2.1e-3), ("hexagon", 4.8e-3)] {
+    // OCCT's G1 errors on the same holes: crates/pdeshape-io/bench/occt_filling.py
+    for (name, occt_g1) in [("triangle", 2.5e-3), ("pentagon", 1.9e-3), ("hexagon", 4.7e-3)] {
         let scene = Scene::load(&example(&format!("fill-sphere-{name}.toml"))).unwrap();
         let p = scene.patch("cap").unwrap();
         let d = model::patch_diagnostics(p).to_json();
