@@ -71,7 +71,9 @@ fn box_corner_is_filled_with_exact_g1_near_the_sphere_octant() {
     // round-off, as for the sphere holes (measured 1.6e-15 rad, gap 7.6e-16)
     assert!(g1 <= 1e-13 && gap <= 1e-14, "G1 {g1}, gap {gap}");
     assert_eq!(f["folds"], 0);
-    for a in f["corner_normal_angles_radians"].as_array().unwrap() {
+    let corners = f["corner_normal_angles_radians"].as_array().unwrap();
+    assert_eq!(corners.len(), 3, "{f}");
+    for a in corners {
         assert!(a.as_f64().unwrap() < 1e-12, "the fillets meet G1 at the corners: {a}");
     }
     let c = pdeshape_core::Vec3::new(-r, -r, -r);
@@ -142,12 +144,12 @@ fn wing_root_is_filled_with_exact_g2() {
     assert!(g1 <= 1e-12 && gap <= 1e-13 && g2 <= 1e-11, "G1 {g1}, gap {gap}, G2 {g2}");
     assert!(f["edge_samples"].as_u64().unwrap() >= 1000);
     assert_eq!(f["folds"], 0);
-    for (a, c) in f["corner_normal_angles_radians"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(f["corner_curvature_gaps_relative"].as_array().unwrap())
-    {
+    let (angles, gaps) = (
+        f["corner_normal_angles_radians"].as_array().unwrap(),
+        f["corner_curvature_gaps_relative"].as_array().unwrap(),
+    );
+    assert_eq!((angles.len(), gaps.len()), (4, 4), "{f}");
+    for (a, c) in angles.iter().zip(gaps) {
         let (a, c) = (a.as_f64().unwrap(), c.as_f64().unwrap());
         assert!(a < 1e-12 && c < 1e-12, "corner: normal angle {a}, curvature gap {c}");
     }
@@ -231,7 +233,10 @@ fn a_trim_hole_is_plugged_with_g2() {
     assert_eq!(f["folds"], 0);
     // the corners lie on one smooth surface: no mismatch of planes or curvatures
     for k in ["corner_normal_angles_radians", "corner_curvature_gaps_relative"] {
-        for a in f[k].as_array().unwrap() {
+        let corners = f[k].as_array().unwrap();
+        assert_eq!(corners.len(), f["edges"].as_u64().unwrap() as usize, "{k}: {f}");
+        assert!(corners.len() >= 3, "{k}: {f}");
+        for a in corners {
             assert!(a.as_f64().unwrap() < 1e-10, "{k}: {a}");
         }
     }

@@ -90,7 +90,7 @@ fn check_example(name: &str, at: &[f64]) -> Result<(), TestCaseError> {
 
 /// Random slider settings per example (failures are kept in `proptest-regressions/` and
 /// tried first on the next run); the same count for every example, so none goes unvisited.
-const CASES: u32 = 4;
+const CASES: u32 = 8;
 
 macro_rules! every_example {
     ($($test:ident => $file:literal,)*) => {

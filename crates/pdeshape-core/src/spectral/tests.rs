@@ -140,7 +140,7 @@ fn random_curve(seed: &[f64]) -> FieldRef {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 10, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 32, .. ProptestConfig::default() })]
     /// Random orders, random Hermite/interior condition mixes, random data: every
     /// condition holds to 1e-10 (relative) at 1000 v samples.
     #[test]
