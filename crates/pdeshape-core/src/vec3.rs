@@ -89,11 +89,29 @@ impl Vec3 {
         max_nan(max_nan(self.x.abs(), self.y.abs()), self.z.abs())
     }
 
-    /// The unit vector in the direction of `a`, or `None` for a (numerically) zero vector.
+    /// The unit vector in the direction of `a`, or `None` for a zero vector or one with a
+    /// non-finite component. Where the squared length under- or overflows (components
+    /// below ~1e-154 or above ~1e154: a scene at 1e-160 or 1e150) the vector is scaled by
+    /// its largest component first, so its direction is kept.
+    ///
+    /// ```
+    /// use pdeshape_core::Vec3;
+    /// assert_eq!(Vec3::new(3e200, 0.0, 4e200).normalized(), Some(Vec3::new(0.6, 0.0, 0.8)));
+    /// assert!(Vec3::new(0.0, 1e-200, 0.0).normalized().is_some());
+    /// assert!(Vec3::ZERO.normalized().is_none());
+    /// ```
     #[inline]
     pub fn normalized(self) -> Option<Vec3> {
         let n = self.norm();
-        (n > 0.0 && n.is_finite()).then(|| self / n)
+        if n > 0.0 && n.is_finite() {
+            return Some(self / n);
+        }
+        let m = self.max_abs();
+        if !(m > 0.0 && m.is_finite()) {
+            return None;
+        }
+        let s = self / m;
+        Some(s / s.norm())
     }
 
     /// Componentwise minimum (NaN where either component is NaN, so a bounding box of

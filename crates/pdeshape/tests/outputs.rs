@@ -50,16 +50,19 @@ fn a_fifo_is_written_into_not_replaced() {
     {
         let fifo = dir.path().join(name);
         mkfifo(&fifo);
-        let reader = {
+        // the reader reports through a channel: where the FIFO was replaced its open()
+        // never returns, and the test fails after a time-out instead of hanging
+        let (tx, rx) = std::sync::mpsc::channel();
+        {
             let fifo = fifo.clone();
-            std::thread::spawn(move || std::fs::read(&fifo).unwrap())
-        };
+            std::thread::spawn(move || tx.send(std::fs::read(&fifo).unwrap()));
+        }
         let mut a = args.clone();
         let scene = example("hermite-blend.toml");
         a.extend([path_str(&scene), "-o", path_str(&fifo)]);
         let o = pdeshape(&a);
         assert_eq!(o.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&o.stderr));
-        let bytes = reader.join().unwrap();
+        let bytes = rx.recv_timeout(std::time::Duration::from_secs(30)).expect("the FIFO's reader got nothing");
         assert!(
             bytes.starts_with(magic),
             "{name}: the reader got {} bytes: {:?}",
@@ -180,4 +183,31 @@ fn step_options_with_a_mesh_output_are_a_usage_error() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("STEP output only"), "{err}");
     assert!(!out.exists());
+}
+
+/// A scene at 1e150 renders as the same scene at 1 (the picture was flat: unit normals of
+/// cross products whose squares overflowed were dropped): at most 1 % of the pixels differ
+/// by more than 8 of 255 in any channel (round-off moves a few edge pixels).
+#[test]
+fn a_scene_at_1e150_renders_like_the_same_scene_at_1() {
+    use pdeshape_io::scene::Scene;
+    let picture = |scale: &str| {
+        let text = format!(
+            "[curves.a]\nexpr = [\"{scale}*cos(v)\", \"{scale}*sin(v)\", \"0\"]\n\
+             [curves.b]\nexpr = [\"{scale}*(1.5 + 0.2*cos(3*v))*cos(v)\", \"{scale}*1.5*sin(v)\", \"{scale}\"]\n\
+             [patches.p]\nkind = \"hermite\"\nconditions = [{{ u = 0, curve = \"a\" }}, {{ u = 1, curve = \"b\" }}]\n"
+        );
+        let scene = Scene::parse(&text, "s.toml", "s", &Default::default()).unwrap();
+        pdeshape_io::model::render_scene(&scene).unwrap()
+    };
+    let (a, b) = (picture("1"), picture("1e150"));
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let pixels = a.data.len() / 4;
+    let differ = a
+        .data
+        .chunks(4)
+        .zip(b.data.chunks(4))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(differ * 100 <= pixels, "{differ} of {pixels} pixels differ");
 }
