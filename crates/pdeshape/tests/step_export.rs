@@ -446,3 +446,25 @@ fn a_tolerance_beyond_the_geometry_is_refused() {
         assert!(!out.exists());
     }
 }
+
+/// A patch that is one point was fitted for 1.2 s to "tolerance 0 was not reached": it is
+/// refused at once as having no face.
+#[test]
+fn a_patch_that_is_one_point_has_no_face() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("point.toml");
+    std::fs::write(
+        &scene,
+        "[curves.a]\nexpr = [\"1\", \"2\", \"3\"]\n[patches.p]\nkind = \"hermite\"\n\
+         conditions = [{ u = 0, curve = \"a\" }, { u = 1, curve = \"a\" }]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("x.step");
+    let t = std::time::Instant::now();
+    let o = build(&scene, &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("single point"), "{err}");
+    assert!(t.elapsed().as_secs_f64() < 1.0, "{:?}", t.elapsed());
+    assert!(!out.exists());
+}
