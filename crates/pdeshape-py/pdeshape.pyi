@@ -65,11 +65,14 @@ class Scene:
         solver: Optional[str] = None,
         terms: Optional[int] = None,
         limits: Optional[Dict[str, int]] = None,
+        time_limit: Optional[float] = None,
         **params: float,
     ) -> Scene:
         """Loads and solves a scene file; `limits` sets caps as the CLI's `--limit` does
         (order, modes, collocation, vertices, memory and scene in MiB); the memory cap also
-        bounds the arrays that `evaluate` and `derivatives` return (MemoryError)."""
+        bounds the arrays that `evaluate` and `derivatives` return (MemoryError).
+        `time_limit` (seconds, default 600, 0: none) bounds the solve and every mesh
+        (TimeoutError)."""
     @staticmethod
     def from_toml(
         text: str,
@@ -78,6 +81,7 @@ class Scene:
         solver: Optional[str] = None,
         terms: Optional[int] = None,
         limits: Optional[Dict[str, int]] = None,
+        time_limit: Optional[float] = None,
         **params: float,
     ) -> Scene:
         """Parses and solves scene text, held to the `scene` cap (16 MiB by default)."""

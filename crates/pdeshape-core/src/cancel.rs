@@ -94,10 +94,49 @@ pub fn run<T: Send>(flag: &Arc<AtomicBool>, threads: usize, f: impl FnOnce() -> 
     }
 }
 
+/// Runs `f` as [`run`] does, with a deadline `limit` from now: a watchdog thread raises the
+/// flag then, and `f` stops at its next checkpoint (`Err(Cancelled)`). The CLI's and
+/// Python's time limits.
+pub fn within<T: Send>(
+    limit: std::time::Duration,
+    threads: usize,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T, Cancelled> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+    let watchdog = {
+        let flag = flag.clone();
+        std::thread::spawn(move || {
+            if let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = done_rx.recv_timeout(limit) {
+                flag.store(true, Ordering::SeqCst);
+            }
+        })
+    };
+    let r = run(&flag, threads, f);
+    drop(done_tx);
+    let _ = watchdog.join();
+    r
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use rayon::prelude::*;
+
+    /// A loop that would run for ever stops at the deadline; one that ends first returns.
+    #[test]
+    fn within_stops_at_the_deadline() {
+        let t = std::time::Instant::now();
+        let r = within(std::time::Duration::from_millis(200), 1, || {
+            loop {
+                checkpoint();
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+        });
+        assert_eq!(r, Err::<(), _>(Cancelled));
+        assert!(t.elapsed() < std::time::Duration::from_secs(5), "{:?}", t.elapsed());
+        assert_eq!(within(std::time::Duration::from_secs(60), 1, || 7), Ok(7));
+    }
 
     #[test]
     fn parallel_loops_stop_on_every_worker() {

@@ -16,7 +16,9 @@ use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::sample::{Target, points_into};
 use pdeshape_io::scene::{LoadOptions, Scene as IoScene, SceneError as IoSceneError, ScenePatch};
-use pyo3::exceptions::{PyException, PyKeyError, PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{
+    PyException, PyKeyError, PyMemoryError, PyRuntimeError, PyTimeoutError, PyTypeError, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;
@@ -78,14 +80,49 @@ fn scene_error(mut e: IoSceneError) -> PyErr {
 struct Scene {
     inner: Arc<IoScene>,
     opts: LoadOptions,
+    /// Seconds a solve or a mesh may take (0: no limit).
+    time_limit: f64,
+}
+
+/// The default time limit of solves and meshes, as the CLI's.
+const DEFAULT_TIME_LIMIT: f64 = 600.0;
+
+/// Runs `f` without the GIL under the time limit (`seconds`, 0: none): past it the
+/// computation stops at its next checkpoint and `TimeoutError` is raised.
+fn limited<T: Send>(py: Python<'_>, seconds: f64, what: &str, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    if seconds <= 0.0 {
+        return Ok(py.detach(f));
+    }
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    py.detach(|| pdeshape_core::cancel::within(std::time::Duration::from_secs_f64(seconds), threads, f)).map_err(|_| {
+        PyTimeoutError::new_err(format!(
+            "{what} ran past the time limit of {seconds} s and was stopped; pass time_limit=SECONDS to Scene.load or Scene.from_toml (0: no limit)"
+        ))
+    })
+}
+
+/// A time limit given to `Scene.load`/`from_toml`: finite and not negative.
+fn time_limit(t: Option<f64>) -> PyResult<f64> {
+    match t {
+        None => Ok(DEFAULT_TIME_LIMIT),
+        Some(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        Some(t) => Err(PyValueError::new_err(format!("time_limit = {t}: seconds, 0 or more (0: no limit)"))),
+    }
 }
 
 impl Scene {
-    fn build(text: &str, file: &str, name: &str, opts: LoadOptions, py: Python<'_>) -> PyResult<Scene> {
-        let inner = py
-            .detach(|| IoScene::parse_with(text, file, name, &opts).map_err(Box::new))
-            .map_err(|e| scene_error(*e))?;
-        Ok(Scene { inner: Arc::new(inner), opts })
+    fn build(
+        text: &str,
+        file: &str,
+        name: &str,
+        opts: LoadOptions,
+        time_limit: f64,
+        py: Python<'_>,
+    ) -> PyResult<Scene> {
+        let inner =
+            limited(py, time_limit, "the solve", || IoScene::parse_with(text, file, name, &opts).map_err(Box::new))?
+                .map_err(|e| scene_error(*e))?;
+        Ok(Scene { inner: Arc::new(inner), opts, time_limit })
     }
 
     fn options(
@@ -128,27 +165,32 @@ impl Scene {
     /// override blends' solvers as the CLI's `--solver` and `--terms` do; `limits` sets caps
     /// as the CLI's `--limit` does (`limits={"memory": 1024, "modes": 1024}`; names: order,
     /// modes, collocation, vertices, memory in MiB, scene in MiB). The memory cap also
-    /// bounds the arrays `evaluate` and `derivatives` return.
+    /// bounds the arrays `evaluate` and `derivatives` return. `time_limit` (seconds, default
+    /// 600 as in the CLI, 0: none) bounds the solve and every mesh: past it they stop and
+    /// raise `TimeoutError`.
     #[staticmethod]
-    #[pyo3(signature = (path, *, solver=None, terms=None, limits=None, **params))]
+    #[pyo3(signature = (path, *, solver=None, terms=None, limits=None, time_limit=None, **params))]
     fn load(
         py: Python<'_>,
         path: std::path::PathBuf,
         solver: Option<String>,
         terms: Option<usize>,
         limits: Option<&Bound<'_, PyDict>>,
+        time_limit: Option<f64>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
+        let time_limit = self::time_limit(time_limit)?;
         let opts = Scene::options(solver, terms, limits, params)?;
         let text = pdeshape_io::scene::read_scene_file(&path, &opts.limits).map_err(scene_error)?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-        Scene::build(&text, &path.display().to_string(), &name, opts, py)
+        Scene::build(&text, &path.display().to_string(), &name, opts, time_limit, py)
     }
 
     /// Parses and solves scene text (TOML); `name` labels errors and exports. The text is
     /// held to the `scene` cap as files are (16 MiB unless `limits` says otherwise).
     #[staticmethod]
-    #[pyo3(signature = (text, name="scene", *, solver=None, terms=None, limits=None, **params))]
+    #[pyo3(signature = (text, name="scene", *, solver=None, terms=None, limits=None, time_limit=None, **params))]
+    #[allow(clippy::too_many_arguments)]
     fn from_toml(
         py: Python<'_>,
         text: &str,
@@ -156,13 +198,15 @@ impl Scene {
         solver: Option<String>,
         terms: Option<usize>,
         limits: Option<&Bound<'_, PyDict>>,
+        time_limit: Option<f64>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
+        let time_limit = self::time_limit(time_limit)?;
         let opts = Scene::options(solver, terms, limits, params)?;
         opts.limits
             .check(Cap::Scene, (text.len() as u128).div_ceil(1 << 20), "the scene text's size")
             .map_err(|e| SceneError::new_err(py_message(&format!("{name}: {e}"))))?;
-        Scene::build(text, name, name, opts, py)
+        Scene::build(text, name, name, opts, time_limit, py)
     }
 
     /// A new scene with parameters changed (`scene.set(a=1.37)`), solved again.
@@ -171,7 +215,7 @@ impl Scene {
         let mut opts = self.opts.clone();
         opts.params.extend(Scene::options(None, None, None, values)?.params);
         let s = &self.inner;
-        Scene::build(&s.source, &s.file, &s.name, opts, py)
+        Scene::build(&s.source, &s.file, &s.name, opts, self.time_limit, py)
     }
 
     /// The parameters in file order: name → {value, min, max, step, expr, description}.
@@ -194,13 +238,15 @@ impl Scene {
     /// The patches in file order.
     #[getter]
     fn patches(&self) -> Vec<Patch> {
-        (0..self.inner.patches.len()).map(|index| Patch { scene: self.inner.clone(), index }).collect()
+        (0..self.inner.patches.len())
+            .map(|index| Patch { scene: self.inner.clone(), index, time_limit: self.time_limit })
+            .collect()
     }
 
     /// The patch called `name` (KeyError names the patches there are).
     fn patch(&self, name: &str) -> PyResult<Patch> {
         match self.inner.patches.iter().position(|p| p.name == name) {
-            Some(index) => Ok(Patch { scene: self.inner.clone(), index }),
+            Some(index) => Ok(Patch { scene: self.inner.clone(), index, time_limit: self.time_limit }),
             None => Err(PyKeyError::new_err(format!(
                 "no patch named `{name}` (patches: {})",
                 self.inner.patches.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
@@ -273,6 +319,8 @@ impl Scene {
 struct Patch {
     scene: Arc<IoScene>,
     index: usize,
+    /// The scene's time limit for meshes (seconds, 0: none).
+    time_limit: f64,
 }
 
 impl Patch {
@@ -499,7 +547,8 @@ impl Patch {
                 .map_err(|e| PyValueError::new_err(py_message(&e.to_string())))?;
             p.resolution = (nu, nv);
         }
-        let m = py.detach(|| model::patch_mesh_at(&p, t)).map_err(PyRuntimeError::new_err)?;
+        let m = limited(py, self.time_limit, "the mesh", || model::patch_mesh_at(&p, t))?
+            .map_err(PyRuntimeError::new_err)?;
         Ok(Mesh::from_core(py, &m))
     }
 

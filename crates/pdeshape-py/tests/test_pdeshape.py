@@ -223,6 +223,22 @@ def test_the_memory_cap_bounds_output_arrays_and_caps_are_set_from_python():
     assert "limits={'modes': 6}" in str(e.value) and "--limit" not in str(e.value), str(e.value)
 
 
+def test_a_mesh_past_the_time_limit_raises_timeout_error():
+    """mesh(resolution=(2, 2_000_000)) (within the vertex cap) ran for minutes with no
+    bound; with time_limit=0.5 it stops at a checkpoint and raises TimeoutError."""
+    import time
+
+    scene = pdeshape.Scene.load(ROOT / "examples/hermite-ruled.toml", time_limit=0.5)
+    t = time.perf_counter()
+    with pytest.raises(TimeoutError, match="time limit of 0.5 s"):
+        scene.patches[0].mesh(resolution=(2, 2_000_000))
+    assert time.perf_counter() - t < 10
+    # the scene is still usable, and a small mesh is within the limit
+    assert scene.patches[0].mesh(resolution=(3, 30)).vertices.shape == (90, 3)
+    with pytest.raises(ValueError, match="time_limit"):
+        pdeshape.Scene.load(ROOT / "examples/hermite-ruled.toml", time_limit=-1)
+
+
 def test_a_time_outside_a_dynamic_blend_raises_in_mesh_as_in_evaluate():
     patch = pdeshape.Scene.load(ROOT / "examples/dynamic-linear.toml").patches[0]
     with pytest.raises(RuntimeError) as e1:

@@ -299,24 +299,8 @@ pub fn run() -> i32 {
 /// error naming the limit and the flag that raises it. Files are written atomically, so a
 /// stopped command leaves none.
 fn within(seconds: f64, f: impl FnOnce() -> Result<()> + Send) -> Result<()> {
-    use std::sync::Arc;
-    use std::sync::atomic::{AtomicBool, Ordering};
-    let flag = Arc::new(AtomicBool::new(false));
-    let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
-    let watchdog = {
-        let flag = flag.clone();
-        let limit = std::time::Duration::from_secs_f64(seconds);
-        std::thread::spawn(move || {
-            if let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = done_rx.recv_timeout(limit) {
-                flag.store(true, Ordering::SeqCst);
-            }
-        })
-    };
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    let r = pdeshape_core::cancel::run(&flag, threads, f);
-    drop(done_tx);
-    let _ = watchdog.join();
-    match r {
+    match pdeshape_core::cancel::within(std::time::Duration::from_secs_f64(seconds), threads, f) {
         Ok(r) => r,
         Err(pdeshape_core::cancel::Cancelled) => Err(anyhow!(
             "the command ran past its time limit of {seconds} s and was stopped (nothing was written); raise it with `--time-limit SECONDS` (0: no limit), or lower the scene's resolution, modes or order"
