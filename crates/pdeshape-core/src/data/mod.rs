@@ -13,18 +13,21 @@
 //!
 //! A field ignores slots it does not depend on (a B-spline curve is constant in `t`).
 
+pub mod analytic;
 mod bspline;
 pub(crate) use bspline::basis_derivatives;
 mod combine;
 mod expr_field;
 mod extension;
 pub mod fourier;
+mod nurbs;
 mod trimline;
 
 pub use bspline::{BSplineCurve, BSplineError};
 pub use combine::Combination;
 pub use expr_field::ExprField;
 pub use extension::EvenExtension;
+pub use nurbs::{NurbsCurve, NurbsError, NurbsSurface};
 pub use trimline::Trimline;
 
 use crate::Vec3;

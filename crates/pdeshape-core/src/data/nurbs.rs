@@ -1,0 +1,354 @@
+//! Rational B-splines (NURBS) with arbitrary knots, as fields: the curves and surfaces of
+//! CAD files.
+//!
+//! A surface is `S(u, v) = A(u, v) / W(u, v)` with the homogeneous sums
+//! `A = Σᵢⱼ Nᵢ(u) Mⱼ(v) wᵢⱼ Pᵢⱼ` and `W = Σᵢⱼ Nᵢ(u) Mⱼ(v) wᵢⱼ`; a curve likewise in one
+//! parameter. The Taylor coefficients of `A` and `W` at a point are the basis functions'
+//! exact derivatives (The NURBS Book, A2.3) over `i! j!`; `S` is then the jet quotient
+//! `A / W` — the quotient rule to every order, exact (no finite differences). Without
+//! weights (or all weights equal) `W` is constant and the quotient is skipped.
+//!
+//! Outside the knot range the end spans' polynomials continue (what a Newton step or a
+//! reparametrisation around an edge needs); the domain is [`NurbsSurface::domain`].
+
+use super::{Field, VecJet};
+use crate::Vec3;
+use crate::jet::{Jet, JetShape};
+
+/// Invalid NURBS input.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NurbsError {
+    /// Degree 0 or above 25.
+    #[error("degree {0} is not supported (1 … 25)")]
+    Degree(usize),
+    /// The knot vector does not fit the control points, is not finite or decreases.
+    #[error("{0}")]
+    Knots(String),
+    /// A control point or weight is not finite, or a weight is not positive.
+    #[error("{0}")]
+    Points(String),
+}
+
+const MAX_DEGREE: usize = 25;
+
+fn check_knots(dir: &str, knots: &[f64], n: usize, p: usize) -> Result<(), NurbsError> {
+    if !(1..=MAX_DEGREE).contains(&p) {
+        return Err(NurbsError::Degree(p));
+    }
+    if n < p + 1 {
+        return Err(NurbsError::Knots(format!("{dir}: {n} control points are too few for degree {p}")));
+    }
+    if knots.len() != n + p + 1 {
+        return Err(NurbsError::Knots(format!(
+            "{dir}: {} knots for {n} control points of degree {p} (needs {})",
+            knots.len(),
+            n + p + 1
+        )));
+    }
+    if let Some(i) = knots.iter().position(|k| !k.is_finite()) {
+        return Err(NurbsError::Knots(format!("{dir}: knot {i} is not finite")));
+    }
+    if let Some(i) = knots.windows(2).position(|w| w[1] < w[0]) {
+        return Err(NurbsError::Knots(format!("{dir}: knot {} is less than knot {i}", i + 1)));
+    }
+    if knots[n] <= knots[p] {
+        return Err(NurbsError::Knots(format!("{dir}: the knot range [{}, {}] is empty", knots[p], knots[n])));
+    }
+    // no knot of multiplicity above p + 1 inside: the basis would be discontinuous there
+    // beyond what A2.3 handles (a span of zero length is skipped by the span search)
+    Ok(())
+}
+
+/// The span `s` with `knots[s] ≤ x < knots[s + 1]`, `p ≤ s < n`, the end spans taken for
+/// `x` outside the range (The NURBS Book A2.1, by bisection).
+fn find_span(knots: &[f64], n: usize, p: usize, x: f64) -> usize {
+    if x >= knots[n] {
+        // the last non-empty span
+        let mut s = n - 1;
+        while s > p && knots[s] >= knots[n] {
+            s -= 1;
+        }
+        return s;
+    }
+    if x <= knots[p] {
+        let mut s = p;
+        while s + 1 < n && knots[s + 1] <= knots[p] {
+            s += 1;
+        }
+        return s;
+    }
+    let (mut lo, mut hi) = (p, n);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if x < knots[mid] { hi = mid } else { lo = mid }
+    }
+    lo
+}
+
+/// Basis derivatives `dᵏNᵣ/dxᵏ / k!` for `k ≤ nd` (zero above the degree), at span `s`.
+fn basis_taylor(knots: &[f64], p: usize, s: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
+    let d = super::basis_derivatives(knots, p, s, x, nd);
+    let mut out = vec![vec![0.0; p + 1]; nd + 1];
+    let mut fact = 1.0;
+    for (k, row) in out.iter_mut().enumerate() {
+        if k > 0 {
+            fact *= k as f64;
+        }
+        if let Some(dk) = d.get(k) {
+            for (o, v) in row.iter_mut().zip(dk) {
+                *o = v / fact;
+            }
+        }
+    }
+    out
+}
+
+fn homogeneous(points: &[Vec3], weights: Option<&[f64]>) -> Result<(Vec<[f64; 4]>, bool), NurbsError> {
+    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+        return Err(NurbsError::Points(format!("control point {i} is not finite")));
+    }
+    let Some(w) = weights else {
+        return Ok((points.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect(), false));
+    };
+    if w.len() != points.len() {
+        return Err(NurbsError::Points(format!("{} weights for {} control points", w.len(), points.len())));
+    }
+    if let Some(i) = w.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(NurbsError::Points(format!("weight {i} = {} is not a positive number", w[i])));
+    }
+    let rational = w.iter().any(|x| *x != w[0]);
+    Ok((points.iter().zip(w).map(|(p, w)| [p.x * w, p.y * w, p.z * w, *w]).collect(), rational))
+}
+
+/// `A / W` from the homogeneous components' jets (`W` constant when not rational).
+fn quotient(h: [Jet; 4], rational: bool) -> VecJet {
+    let [x, y, z, w] = h;
+    if rational {
+        VecJet([x.div(&w), y.div(&w), z.div(&w)])
+    } else {
+        let s = 1.0 / w.value();
+        VecJet([x.scale(s), y.scale(s), z.scale(s)])
+    }
+}
+
+/// A NURBS surface `S(u, v)` (slots `u`, `v`; constant in a third).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NurbsSurface {
+    pu: usize,
+    pv: usize,
+    ku: Vec<f64>,
+    kv: Vec<f64>,
+    nu: usize,
+    nv: usize,
+    /// `[w x, w y, w z, w]`, index `i nv + j`.
+    cw: Vec<[f64; 4]>,
+    rational: bool,
+}
+
+impl NurbsSurface {
+    /// A surface of degrees `(pu, pv)` on the expanded knot vectors `ku`, `kv` with the
+    /// `nu × nv` control points `points[i nv + j]` (`i` along `u`) and optional weights in
+    /// the same order.
+    pub fn new(
+        (pu, pv): (usize, usize),
+        ku: Vec<f64>,
+        kv: Vec<f64>,
+        (nu, nv): (usize, usize),
+        points: &[Vec3],
+        weights: Option<&[f64]>,
+    ) -> Result<Self, NurbsError> {
+        check_knots("u", &ku, nu, pu)?;
+        check_knots("v", &kv, nv, pv)?;
+        if points.len() != nu * nv {
+            return Err(NurbsError::Points(format!("{} control points for a {nu} × {nv} net", points.len())));
+        }
+        let (cw, rational) = homogeneous(points, weights)?;
+        Ok(NurbsSurface { pu, pv, ku, kv, nu, nv, cw, rational })
+    }
+
+    /// The knot ranges `([u₀, u₁], [v₀, v₁])`.
+    pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        ((self.ku[self.pu], self.ku[self.nu]), (self.kv[self.pv], self.kv[self.nv]))
+    }
+
+    /// Whether the weights differ (a rational surface).
+    pub fn is_rational(&self) -> bool {
+        self.rational
+    }
+}
+
+impl Field for NurbsSurface {
+    fn arity(&self) -> usize {
+        2
+    }
+
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let [ou, ov, _] = shape.orders();
+        let (u, v) = (at[0], at.get(1).copied().unwrap_or(0.0));
+        let su = find_span(&self.ku, self.nu, self.pu, u);
+        let sv = find_span(&self.kv, self.nv, self.pv, v);
+        let bu = basis_taylor(&self.ku, self.pu, su, u, ou);
+        let bv = basis_taylor(&self.kv, self.pv, sv, v, ov);
+        let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
+        for (i, rowu) in bu.iter().enumerate() {
+            for (k, rowv) in bv.iter().enumerate() {
+                let idx = shape.index([i, k, 0]);
+                let mut acc = [0.0; 4];
+                for (a, nu) in rowu.iter().enumerate() {
+                    if *nu == 0.0 {
+                        continue;
+                    }
+                    let base = (su - self.pu + a) * self.nv + sv - self.pv;
+                    let mut inner = [0.0; 4];
+                    for (b, mv) in rowv.iter().enumerate() {
+                        let p = &self.cw[base + b];
+                        for q in 0..4 {
+                            inner[q] += mv * p[q];
+                        }
+                    }
+                    for q in 0..4 {
+                        acc[q] += nu * inner[q];
+                    }
+                }
+                for q in 0..4 {
+                    c[q][idx] = acc[q];
+                }
+            }
+        }
+        quotient(c.map(|c| Jet::from_coeffs(shape, c)), self.rational)
+    }
+
+    fn is_constant_in(&self, slot: usize) -> bool {
+        slot >= 2
+    }
+}
+
+/// A NURBS curve `C(τ)` (slot `τ`; constant in others).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NurbsCurve {
+    p: usize,
+    knots: Vec<f64>,
+    cw: Vec<[f64; 4]>,
+    rational: bool,
+}
+
+impl NurbsCurve {
+    /// A curve of degree `p` on the expanded knot vector `knots` with optional weights.
+    pub fn new(p: usize, knots: Vec<f64>, points: &[Vec3], weights: Option<&[f64]>) -> Result<Self, NurbsError> {
+        check_knots("t", &knots, points.len(), p)?;
+        let (cw, rational) = homogeneous(points, weights)?;
+        Ok(NurbsCurve { p, knots, cw, rational })
+    }
+
+    /// The knot range `[τ₀, τ₁]`.
+    pub fn domain(&self) -> (f64, f64) {
+        (self.knots[self.p], self.knots[self.cw.len()])
+    }
+}
+
+impl Field for NurbsCurve {
+    fn arity(&self) -> usize {
+        1
+    }
+
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let [o, _, _] = shape.orders();
+        let n = self.cw.len();
+        let s = find_span(&self.knots, n, self.p, at[0]);
+        let b = basis_taylor(&self.knots, self.p, s, at[0], o);
+        let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
+        for (k, row) in b.iter().enumerate() {
+            let idx = shape.index([k, 0, 0]);
+            for (a, nb) in row.iter().enumerate() {
+                let p = &self.cw[s - self.p + a];
+                for q in 0..4 {
+                    c[q][idx] += nb * p[q];
+                }
+            }
+        }
+        quotient(c.map(|c| Jet::from_coeffs(shape, c)), self.rational)
+    }
+
+    fn is_constant_in(&self, slot: usize) -> bool {
+        slot >= 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_1_SQRT_2;
+
+    /// The quarter circle as a rational quadratic Bézier (control points (1,0), (1,1),
+    /// (0,1), weights 1, √2/2, 1) against its homogeneous polynomials written out by hand,
+    /// `A = (1 + (2w−2)τ + (1−2w)τ², 2wτ + (1−2w)τ²)`, `W = 1 + (2w−2)τ + (2−2w)τ²`, and
+    /// the quotient rule to the second derivative.
+    #[test]
+    fn quarter_circle_against_the_quotient_rule_by_hand() {
+        let w = FRAC_1_SQRT_2;
+        let pts = [Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        let c = NurbsCurve::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], &pts, Some(&[1.0, w, 1.0])).unwrap();
+        for t in [0.0, 0.3, 0.71, 1.0] {
+            // A = (a0 + a1 t + a2 t², …), W = w0 + w1 t + w2 t²: coefficients by hand
+            let ax = [1.0, 2.0 * w - 2.0, 1.0 - 2.0 * w];
+            let ay = [0.0, 2.0 * w, 1.0 - 2.0 * w];
+            let ww = [1.0, 2.0 * w - 2.0, 2.0 - 2.0 * w];
+            let poly = |c: &[f64; 3], t: f64| [c[0] + c[1] * t + c[2] * t * t, c[1] + 2.0 * c[2] * t, 2.0 * c[2]];
+            let (x, y, wv) = (poly(&ax, t), poly(&ay, t), poly(&ww, t));
+            // quotient rule: f = a/w, f' = (a' − f w')/w, f'' = (a'' − 2 f' w' − f w'')/w
+            let q = |a: [f64; 3]| {
+                let f0 = a[0] / wv[0];
+                let f1 = (a[1] - f0 * wv[1]) / wv[0];
+                let f2 = (a[2] - 2.0 * f1 * wv[1] - f0 * wv[2]) / wv[0];
+                [f0, f1, f2]
+            };
+            let (fx, fy) = (q(x), q(y));
+            let j = c.jet(&[t], JetShape::new(&[2]));
+            for k in 0..3 {
+                let d = j.derivative([k, 0, 0]);
+                // a few ulps of the values (≤ 2 in size): round-off of the jet division
+                assert!((d.x - fx[k]).abs() < 1e-14 && (d.y - fy[k]).abs() < 1e-14, "t {t} k {k}: {d}");
+            }
+            // on the unit circle
+            assert!((j.value().norm() - 1.0).abs() < 1e-15);
+        }
+    }
+
+    /// A bilinear-times-quadratic surface with distinct inner knots against its closed
+    /// form: the tensor product of a degree-1 curve in `u` (knots 0 0 1 2 2: the hat
+    /// functions) and a clamped quadratic Bézier in `v`, weights all 2 (not rational).
+    #[test]
+    fn tensor_product_against_the_closed_form() {
+        let ku = vec![0.0, 0.0, 1.0, 2.0, 2.0];
+        let kv = vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+        let mut pts = Vec::new();
+        for i in 0..3 {
+            for j in 0..3 {
+                pts.push(Vec3::new(i as f64, j as f64, (i * j) as f64));
+            }
+        }
+        let s = NurbsSurface::new((1, 2), ku, kv, (3, 3), &pts, Some(&[2.0; 9])).unwrap();
+        assert!(!s.is_rational());
+        // x = u (hat functions interpolate i at u = i), y = 2v (Bézier of 0,1,2), z = Σ i j …
+        for (u, v) in [(0.3, 0.2), (1.5, 0.9), (1.0, 0.5)] {
+            let j = s.jet(&[u, v], JetShape::new(&[1, 2]));
+            let bz = |c: [f64; 3], v: f64| c[0] * (1.0 - v).powi(2) + 2.0 * c[1] * v * (1.0 - v) + c[2] * v * v;
+            // x(u) = u, y = 2v, z = u · (Bézier of 0, 1, 2) = u · 2v
+            let want = Vec3::new(u, bz([0.0, 1.0, 2.0], v), u * bz([0.0, 1.0, 2.0], v));
+            assert!((j.value() - want).norm() < 1e-15, "{u} {v}");
+            assert!((j.derivative([1, 1, 0]) - Vec3::new(0.0, 0.0, 2.0)).norm() < 1e-14);
+            assert!((j.derivative([0, 2, 0])).norm() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn bad_input_is_named() {
+        let pts = [Vec3::ZERO; 3];
+        let e = NurbsCurve::new(2, vec![0.0, 0.0, 1.0, 1.0], &pts, None).unwrap_err();
+        assert_eq!(e.to_string(), "t: 4 knots for 3 control points of degree 2 (needs 6)");
+        let e = NurbsCurve::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], &pts, Some(&[1.0, 0.0, 1.0])).unwrap_err();
+        assert_eq!(e.to_string(), "weight 1 = 0 is not a positive number");
+        let e = NurbsCurve::new(2, vec![0.0, 0.0, 0.0, 1.0, 0.5, 1.0], &pts, None).unwrap_err();
+        assert_eq!(e.to_string(), "t: knot 4 is less than knot 3");
+    }
+}
