@@ -52,6 +52,7 @@
 mod crease;
 mod curve;
 mod data;
+mod foot;
 
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
@@ -60,6 +61,7 @@ use crate::patch::{Condition, Surface, VDomain};
 use crate::spectral::{SpectralError, SpectralOptions, SpectralPatch};
 pub use curve::{AlongCurve, DomainCurve, Host};
 use data::{LoopData, Piece, second_frame};
+pub use foot::{FootCurve, FootError, foot_of};
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
@@ -75,6 +77,10 @@ pub struct FillEdge {
     pub w: (f64, f64),
     /// Length of the cross tangent relative to the loop's mean radius (> 0).
     pub fullness: f64,
+    /// Which way the cross tangent points: `Some(1.0)` along `+S_s`, `Some(-1.0)` along
+    /// `−S_s`; `None`: towards the loop's centroid (a CAD face's edge knows the side its
+    /// material is on, which the centroid does not tell at, e.g., a cylinder's rim).
+    pub side: Option<f64>,
 }
 
 /// Options of a fill.
@@ -613,7 +619,11 @@ impl Fill {
             if area.is_nan() || area <= 1e-12 * ss.norm() * sw.norm() {
                 return Err(FillError::Loop(format!("edge {k}: the neighbour's s-derivative is parallel to the edge")));
             }
-            let sign = if ss.dot(centroid - p) >= 0.0 { 1.0 } else { -1.0 };
+            let sign = match e.side {
+                Some(s) => s.signum(),
+                None if ss.dot(centroid - p) >= 0.0 => 1.0,
+                None => -1.0,
+            };
             cs.push(sign * e.fullness * radius / ss.norm());
         }
         // corners: the mean cross tangent in each edge's frame

@@ -28,7 +28,13 @@ fn sphere_loop(azimuths: &[f64], theta: f64) -> Vec<FillEdge> {
             let e = [c(0), c(1), c(2)];
             let f =
                 ExprField::parse([e[0].as_str(), e[1].as_str(), e[2].as_str()], &["s", "w", "t"], &|_| None).unwrap();
-            FillEdge { surface: Arc::new(f), s0: 0.0, w: (0.0, a.dot(a1).clamp(-1.0, 1.0).acos()), fullness: 1.0 }
+            FillEdge {
+                surface: Arc::new(f),
+                s0: 0.0,
+                w: (0.0, a.dot(a1).clamp(-1.0, 1.0).acos()),
+                fullness: 1.0,
+                side: None,
+            }
         })
         .collect()
 }
@@ -280,7 +286,7 @@ fn ring_fast_path_matches_its_jets() {
 fn creased_square() -> Vec<FillEdge> {
     let edge = |e: [&str; 3]| {
         let f = ExprField::parse(e, &["s", "w", "t"], &|_| None).unwrap();
-        FillEdge { surface: Arc::new(f), s0: 0.0, w: (-1.0, 1.0), fullness: 1.0 }
+        FillEdge { surface: Arc::new(f), s0: 0.0, w: (-1.0, 1.0), fullness: 1.0, side: None }
     };
     vec![
         edge(["w", "-1 + s", "0.5*abs(-1 + s - 0.5*w)"]),
