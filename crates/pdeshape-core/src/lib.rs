@@ -17,6 +17,7 @@
 #![warn(missing_docs)]
 
 pub mod blend;
+pub mod brep;
 pub mod cancel;
 pub mod data;
 pub mod expr;

@@ -1,0 +1,97 @@
+//! A hole of a boundary representation filled by a fill of order 4 (G1) or 6 (G2):
+//! each edge of the hole, as its face uses it, becomes a fill edge on that face — the
+//! face's surface reparametrised around the edge's foot curve ([`FootCurve`] inside an
+//! [`AlongCurve`]) — and the cross tangent points away from the face's side.
+//!
+//! **Which side.** Along an edge run as its face runs it, the face lies on the left seen
+//! from the face's normal. In the surface's `(u, v)`, whose normal is `S_u × S_v`, that
+//! is the left of the foot curve's direction when the face is `same_sense`, the right
+//! otherwise. The fill edge's `σ` grows along `ν = (−c₂′, c₁′)`, the left of increasing
+//! `τ`; with `d = ±1` the direction of `τ` along the run, the hole is on the side
+//! `−d ν` (`same_sense`) or `+d ν`, which is [`FillEdge::side`].
+//!
+//! A loop of fewer than three edges (a single closed edge, two arcs) is cut into three or
+//! four pieces at equal parameter steps; the cuts are not corners of the neighbours (one
+//! face on both sides), so the fill is G1 there like anywhere along the edge.
+
+use super::{Brep, Hole, HoleKind};
+use crate::fill::{AlongCurve, DomainCurve, Fill, FillEdge, FillError, FillOptions, FootCurve, FootError, Host};
+use crate::num::max_nan;
+use std::sync::Arc;
+
+/// A filled hole.
+pub struct HoleFill {
+    /// The fill.
+    pub fill: Fill,
+    /// The fill's edges: (the hole's use, the edge curve's parameter range run).
+    pub pieces: Vec<(usize, (f64, f64))>,
+    /// The largest distance between an edge's curve and its foot on the face (how far
+    /// the file's edges lie off their faces).
+    pub edge_offset: f64,
+}
+
+/// Why a hole is not filled.
+#[derive(Debug, thiserror::Error)]
+pub enum HoleFillError {
+    /// Not a simple loop.
+    #[error("the loop is not a simple hole ({0:?})")]
+    NotSimple(HoleKind),
+    /// An edge's foot curve on its face.
+    #[error("edge #{edge} on face #{face}: {err}")]
+    Foot {
+        /// The edge's id.
+        edge: u64,
+        /// The face's id.
+        face: u64,
+        /// What failed.
+        err: FootError,
+    },
+    /// A face or edge of the hole has geometry of a kind not read.
+    #[error("{0} has geometry of a kind that is not read")]
+    Unsupported(String),
+    /// The fill.
+    #[error(transparent)]
+    Fill(#[from] FillError),
+}
+
+/// Fills `hole` of `b` with `options` (its order 4 or 6).
+pub fn fill_hole(b: &Brep, hole: &Hole, options: &FillOptions) -> Result<HoleFill, HoleFillError> {
+    if hole.kind != HoleKind::Simple {
+        return Err(HoleFillError::NotSimple(hole.kind));
+    }
+    let n = hole.uses.len();
+    let cuts = match n {
+        1 => 3,
+        2 => 2,
+        _ => 1,
+    };
+    let mut pieces = Vec::new();
+    let mut edges = Vec::new();
+    let mut edge_offset: f64 = 0.0;
+    for (k, u) in hole.uses.iter().enumerate() {
+        let e = &b.edges[u.edge];
+        let f = &b.faces[u.face];
+        let (a, z) = if u.forward { e.range } else { (e.range.1, e.range.0) };
+        let (Some(surface), Some(ec)) = (&f.surface, &e.curve) else {
+            let what = if f.surface.is_none() { format!("face #{}", f.id) } else { format!("edge #{}", e.id) };
+            return Err(HoleFillError::Unsupported(what));
+        };
+        let host = surface.field();
+        let curve = ec.field();
+        for c in 0..cuts {
+            let ta = a + (z - a) * c as f64 / cuts as f64;
+            let tb = a + (z - a) * (c + 1) as f64 / cuts as f64;
+            let start = surface.invert_near(curve.eval(&[ta]));
+            let foot = FootCurve::new(host.clone(), curve.clone(), (ta, tb), start, options.t)
+                .map_err(|err| HoleFillError::Foot { edge: e.id, face: f.id, err })?;
+            edge_offset = max_nan(edge_offset, foot.max_distance());
+            let dir = if tb >= ta { 1.0 } else { -1.0 };
+            let side = if f.same_sense { -dir } else { dir };
+            let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(Arc::new(foot)) };
+            edges.push(FillEdge { surface: Arc::new(along), s0: 0.0, w: (ta, tb), fullness: 1.0, side: Some(side) });
+            pieces.push((k, (ta, tb)));
+        }
+    }
+    let fill = Fill::new(&edges, options)?;
+    Ok(HoleFill { fill, pieces, edge_offset })
+}
