@@ -111,7 +111,16 @@ pub fn edit(data: &[u8]) {
     let Ok(edits) = serde_json::from_str::<Vec<edit::Edit>>(first) else { return };
     let Ok(text) = edit::apply(scene, &edits) else { return };
     let _ = edit::editables(&text);
-    let limits = Limits { order: 16, modes: 32, collocation: 5_000, vertices: 20_000, memory: 64, scene: 1 };
+    let limits = Limits {
+        order: 16,
+        modes: 32,
+        collocation: 5_000,
+        vertices: 20_000,
+        memory: 64,
+        scene: 1,
+        model: 1,
+        entities: 10_000,
+    };
     let opts = LoadOptions { limits, ..Default::default() };
     let Ok(s) = pdeshape_io::scene::Scene::parse_with(&text, "fuzz.toml", "fuzz", &opts) else { return };
     for p in &s.patches {

@@ -31,11 +31,16 @@ pub enum Cap {
     Memory,
     /// Size of a scene file, MiB.
     Scene,
+    /// Size of an imported model file (STEP), MiB.
+    Model,
+    /// Entities of an imported model file.
+    Entities,
 }
 
 impl Cap {
     /// Every cap, in the order of [`Cap::name`]'s list.
-    pub const ALL: [Cap; 6] = [Cap::Order, Cap::Modes, Cap::Collocation, Cap::Vertices, Cap::Memory, Cap::Scene];
+    pub const ALL: [Cap; 8] =
+        [Cap::Order, Cap::Modes, Cap::Collocation, Cap::Vertices, Cap::Memory, Cap::Scene, Cap::Model, Cap::Entities];
 
     /// The name used by `--limit NAME=VALUE`.
     pub fn name(self) -> &'static str {
@@ -46,12 +51,14 @@ impl Cap {
             Cap::Vertices => "vertices",
             Cap::Memory => "memory",
             Cap::Scene => "scene",
+            Cap::Model => "model",
+            Cap::Entities => "entities",
         }
     }
 
     fn unit(self) -> &'static str {
         match self {
-            Cap::Memory | Cap::Scene => " MiB",
+            Cap::Memory | Cap::Scene | Cap::Model => " MiB",
             _ => "",
         }
     }
@@ -75,7 +82,8 @@ pub struct LimitError {
 }
 
 /// The caps in force. Defaults: order 64, modes 512, collocation 250 000 points,
-/// vertices 4 000 000 per patch, memory 4096 MiB, scene files 16 MiB.
+/// vertices 4 000 000 per patch, memory 4096 MiB, scene files 16 MiB, model files 256 MiB
+/// of at most 4 000 000 entities.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     /// Largest PDE order `2N`.
@@ -91,11 +99,24 @@ pub struct Limits {
     pub memory: usize,
     /// Largest scene file, MiB.
     pub scene: usize,
+    /// Largest imported model file (STEP), MiB.
+    pub model: usize,
+    /// Most entities of an imported model file.
+    pub entities: usize,
 }
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { order: 64, modes: 512, collocation: 250_000, vertices: 4_000_000, memory: 4096, scene: 16 }
+        Limits {
+            order: 64,
+            modes: 512,
+            collocation: 250_000,
+            vertices: 4_000_000,
+            memory: 4096,
+            scene: 16,
+            model: 256,
+            entities: 4_000_000,
+        }
     }
 }
 
@@ -109,6 +130,8 @@ impl Limits {
             Cap::Vertices => self.vertices,
             Cap::Memory => self.memory,
             Cap::Scene => self.scene,
+            Cap::Model => self.model,
+            Cap::Entities => self.entities,
         }
     }
 
@@ -121,6 +144,8 @@ impl Limits {
             Cap::Vertices => self.vertices = value,
             Cap::Memory => self.memory = value,
             Cap::Scene => self.scene = value,
+            Cap::Model => self.model = value,
+            Cap::Entities => self.entities = value,
         }
     }
 
