@@ -7,6 +7,8 @@
 
 pub mod cad;
 pub mod export;
+pub mod holes;
+pub mod import;
 pub mod model;
 pub mod render;
 pub mod sample;

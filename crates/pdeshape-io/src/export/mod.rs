@@ -9,6 +9,7 @@ mod gltf;
 mod obj;
 mod ply;
 mod step;
+mod step_sew;
 mod stl;
 mod vtu;
 
@@ -16,6 +17,7 @@ pub use gltf::write_glb;
 pub use obj::write_obj;
 pub use ply::write_ply;
 pub use step::{StepFace, StepHole, check_uncertainty, write_step};
+pub use step_sew::{SewnFace, sewn_step};
 pub use stl::write_stl;
 pub use vtu::{write_vtu_hex, write_vtu_surface};
 

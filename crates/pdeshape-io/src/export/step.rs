@@ -63,7 +63,7 @@ pub struct StepHole<'a> {
 }
 
 /// STEP's REAL: shortest round-trip digits with a decimal point and an upper-case exponent.
-fn real(x: f64) -> String {
+pub(super) fn real(x: f64) -> String {
     let s = format!("{x:?}");
     match s.split_once('e') {
         Some((m, e)) if m.contains('.') => format!("{m}E{e}"),
@@ -90,24 +90,24 @@ fn string(s: &str) -> String {
     out
 }
 
-/// Entities numbered in order of creation.
-struct Entities {
-    text: String,
-    next: usize,
+/// Entities numbered in order of creation, after `next`.
+pub(super) struct Entities {
+    pub(super) text: String,
+    pub(super) next: usize,
 }
 
 impl Entities {
-    fn add(&mut self, body: &str) -> usize {
+    pub(super) fn add(&mut self, body: &str) -> usize {
         self.next += 1;
         let _ = writeln!(self.text, "#{}={body};", self.next);
         self.next
     }
 
-    fn point(&mut self, p: Vec3) -> usize {
+    pub(super) fn point(&mut self, p: Vec3) -> usize {
         self.add(&format!("CARTESIAN_POINT('',({},{},{}))", real(p.x), real(p.y), real(p.z)))
     }
 
-    fn list(ids: impl IntoIterator<Item = usize>) -> String {
+    pub(super) fn list(ids: impl IntoIterator<Item = usize>) -> String {
         let v: Vec<String> = ids.into_iter().map(|i| format!("#{i}")).collect();
         format!("({})", v.join(","))
     }
@@ -119,7 +119,7 @@ impl Entities {
         (format!("({})", m.join(",")), format!("({})", t.join(",")))
     }
 
-    fn curve(&mut self, pts: &[Vec3], k: &Knots, tol: f64) -> usize {
+    pub(super) fn curve(&mut self, pts: &[Vec3], k: &Knots, tol: f64) -> usize {
         let ids: Vec<usize> = pts.iter().map(|&p| self.point(p)).collect();
         let (m, t) = Self::knots(k);
         let closed = if (pts[0] - pts[pts.len() - 1]).norm() <= tol { ".T." } else { ".F." };
@@ -142,7 +142,7 @@ impl Entities {
         ))
     }
 
-    fn surface(&mut self, s: &BSplineSurface) -> usize {
+    pub(super) fn surface(&mut self, s: &BSplineSurface) -> usize {
         let (nu, nv) = s.counts();
         let mut rows = Vec::with_capacity(nu);
         for i in 0..nu {

@@ -1,0 +1,290 @@
+//! The holes of an imported model: listed (a typed report for `holes` and its JSON), and
+//! filled — each hole by a fill of order 4 (G1) or 6 (G2) from the faces around
+//! (`pdeshape_core::brep::fill_hole`), fitted by a B-spline face of degree 3 or 5 that
+//! interpolates the fill's cross derivatives at the loop, measured against the exact
+//! faces around after the fit, and sewn into the model (`export::sewn_step`).
+
+use crate::export::{SewnFace, sewn_step, write_atomic};
+use crate::import::step::StepModel;
+use pdeshape_core::Vec3;
+use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleFill, HoleKind, fill_hole};
+use pdeshape_core::fill::{FillOptions, foot_of};
+use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_surface};
+use pdeshape_core::num::max_nan;
+use serde::Serialize;
+use std::path::Path;
+
+/// Corners whose faces' normals differ by more than this are reported as not G1 (as
+/// `check` judges a fill's corners).
+pub const G1_CORNER: f64 = 1e-9;
+
+/// What `holes` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct HolesReport {
+    /// The file.
+    pub file: String,
+    /// The model's length unit.
+    pub unit: String,
+    /// Counts of the B-rep's shells, faces, edges.
+    pub shells: usize,
+    /// Faces.
+    pub faces: usize,
+    /// Edges.
+    pub edges: usize,
+    /// Faces and edges on geometry that is not read (`#id TYPE`), by the face or edge.
+    pub unsupported: Vec<String>,
+    /// The loops of the free boundary, numbered from 1.
+    pub holes: Vec<HoleReport>,
+}
+
+/// One loop of the free boundary.
+#[derive(Clone, Debug, Serialize)]
+pub struct HoleReport {
+    /// Its number (from 1), as `--holes` takes it.
+    pub index: usize,
+    /// `hole`, `touches itself` or `open chain`.
+    pub kind: &'static str,
+    /// Its edges' ids (`#id`) in loop order.
+    pub edges: Vec<u64>,
+    /// The ids of the faces around, each once.
+    pub faces: Vec<u64>,
+    /// Its length, in the model's unit.
+    pub length: f64,
+    /// Its bounding box `[min, max]`.
+    pub bbox: [[f64; 3]; 2],
+    /// At each corner (the end of each edge): the vertex's id and the angle between the
+    /// two faces' normals (radians).
+    pub corners: Vec<(u64, f64)>,
+    /// Whether the faces meet G1 (angle ≤ [`G1_CORNER`]) at every corner.
+    pub g1_corners: bool,
+}
+
+fn kind_name(k: HoleKind) -> &'static str {
+    match k {
+        HoleKind::Simple => "hole",
+        HoleKind::TouchesItself => "touches itself",
+        HoleKind::Open => "open chain",
+    }
+}
+
+/// The report of `m`'s holes (`holes` computed by the caller, once).
+pub fn holes_report(m: &StepModel, holes: &[Hole]) -> HolesReport {
+    let b = &m.brep;
+    HolesReport {
+        file: m.file.clone(),
+        unit: m.unit.0.clone(),
+        shells: b.shells.len(),
+        faces: b.faces.len(),
+        edges: b.edges.len(),
+        unsupported: m.unsupported.iter().map(|(id, what)| format!("#{id}: {what}")).collect(),
+        holes: holes
+            .iter()
+            .enumerate()
+            .map(|(i, h)| HoleReport {
+                index: i + 1,
+                kind: kind_name(h.kind),
+                edges: h.uses.iter().map(|u| b.edges[u.edge].id).collect(),
+                faces: h.faces().into_iter().map(|f| b.faces[f].id).collect(),
+                length: h.length,
+                bbox: [[h.bbox.0.x, h.bbox.0.y, h.bbox.0.z], [h.bbox.1.x, h.bbox.1.y, h.bbox.1.z]],
+                corners: h.corners.iter().map(|c| (b.vertices[c.vertex].0, c.angle)).collect(),
+                g1_corners: h.corners.iter().all(|c| c.angle <= G1_CORNER),
+            })
+            .collect(),
+    }
+}
+
+/// How holes are filled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FillHolesOptions {
+    /// 4 (G1) or 6 (G2).
+    pub order: usize,
+    /// The holes to fill (numbers from 1); `None`: every simple hole.
+    pub holes: Option<Vec<usize>>,
+    /// Leave loops of more edges open.
+    pub max_edges: Option<usize>,
+    /// The fitted faces' measured maximum deviation from their fills, relative to the
+    /// model's size.
+    pub relative: f64,
+}
+
+impl Default for FillHolesOptions {
+    fn default() -> Self {
+        FillHolesOptions { order: 4, holes: None, max_edges: None, relative: 1e-7 }
+    }
+}
+
+/// A filled hole with its fitted face and the continuity measured after the fit.
+pub struct FilledHole {
+    /// The hole's number (from 1).
+    pub index: usize,
+    /// The fill.
+    pub fill: HoleFill,
+    /// Its B-spline face.
+    pub surface: BSplineSurface,
+    /// The fit.
+    pub fit: FitReport,
+    /// The seam between the face and the faces around, measured on the written face.
+    pub seam: SeamFigures,
+}
+
+/// Continuity between a new face and the faces around its hole, at points of its `u = 0`
+/// side.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SeamFigures {
+    /// Largest distance to the nearest face around.
+    pub gap: f64,
+    /// Largest angle (radians) between the normals.
+    pub angle: f64,
+    /// Largest difference of the normal curvatures across the edge (1/length).
+    pub curvature_gap: f64,
+    /// Largest curvature of the faces around across the edge there.
+    pub curvature: f64,
+    /// `curvature_gap` over the larger of `curvature` and 1 / the model's size.
+    pub relative_curvature_gap: f64,
+    /// Points compared.
+    pub samples: usize,
+}
+
+/// The normal curvature `II(t̂, t̂) / I(t̂, t̂)` of a surface in the direction `t` (in its
+/// tangent plane; `t̂ = a S_u + b S_v` its coordinates) and the unit normal, from the
+/// derivatives `d` in the order of `BSplineSurface::derivatives(…, 2, 2)`: index `3i + k`
+/// for `∂uⁱ∂vᵏS`.
+fn normal_curvature(d: &[Vec3], t: Vec3) -> Option<(f64, Vec3)> {
+    let (su, sv) = (d[3], d[1]);
+    let n = su.cross(sv).normalized()?;
+    // t = a S_u + b S_v
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let det = e * g - f * f;
+    let (tu, tv) = (t.dot(su), t.dot(sv));
+    let a = (g * tu - f * tv) / det;
+    let b = (e * tv - f * tu) / det;
+    let second = d[6] * (a * a) + d[4] * (2.0 * a * b) + d[2] * (b * b);
+    let first = (su * a + sv * b).dot(su * a + sv * b);
+    Some((second.dot(n) / first, n))
+}
+
+/// The continuity of `s` (its `u = 0` side) against the faces `faces` of `b` (whose size
+/// is `size`) at `samples` points.
+pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usize, size: f64) -> SeamFigures {
+    let mut out = SeamFigures { samples, ..Default::default() };
+    let v1 = s.v.knots.last().copied().unwrap_or(1.0);
+    let v0 = s.v.knots.first().copied().unwrap_or(0.0);
+    for i in 0..samples {
+        let v = v0 + (v1 - v0) * (i as f64 + 0.5) / samples as f64;
+        let d = s.derivatives(0.0, v, 2, 2);
+        let p = d[0];
+        // the nearest face around
+        let mut best: Option<(f64, usize, [f64; 2])> = None;
+        for &fi in faces {
+            let Some(fs) = &b.faces[fi].surface else { continue };
+            let field = fs.field();
+            let Some(c) = foot_of(field.as_ref(), p, fs.invert_near(p), 0.0) else { continue };
+            let dist = (field.eval(&c) - p).norm();
+            if best.is_none_or(|x| dist < x.0) {
+                best = Some((dist, fi, c));
+            }
+        }
+        let Some((dist, fi, c)) = best else {
+            out.gap = f64::NAN;
+            continue;
+        };
+        out.gap = max_nan(out.gap, dist);
+        let fs: &FaceSurface = b.faces[fi].surface.as_ref().expect("chosen among faces with surfaces");
+        let nd = {
+            let j = fs.field().jet(&[c[0], c[1], 0.0], pdeshape_core::jet::JetShape::new(&[2, 2]));
+            // the face's derivatives in the order of `BSplineSurface::derivatives`
+            let mut v = Vec::with_capacity(9);
+            for a in 0..=2 {
+                for k in 0..=2 {
+                    v.push(j.derivative([a, k, 0]));
+                }
+            }
+            v
+        };
+        // across the edge: the new face's S_u without its part along the edge
+        let tangent = d[1].normalized().unwrap_or(Vec3::ZERO);
+        let across = (d[3] - tangent * d[3].dot(tangent)).normalized().unwrap_or(Vec3::ZERO);
+        match (normal_curvature(&d, across), normal_curvature(&nd, across)) {
+            (Some((k1, n1)), Some((k2, n2))) => {
+                let angle = n1.cross(n2).norm().atan2(n1.dot(n2).abs());
+                out.angle = max_nan(out.angle, angle);
+                // the normals' orientations may differ: curvature against one normal
+                let k2 = if n1.dot(n2) < 0.0 { -k2 } else { k2 };
+                out.curvature_gap = max_nan(out.curvature_gap, (k1 - k2).abs());
+                out.curvature = max_nan(out.curvature, k2.abs());
+            }
+            _ => out.angle = f64::NAN,
+        }
+    }
+    out.relative_curvature_gap = out.curvature_gap / max_nan(out.curvature, 1.0 / size);
+    out
+}
+
+/// Fills the holes of `m` that `o` asks for; every asked hole must be fillable.
+pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result<Vec<FilledHole>, String> {
+    if o.order != 4 && o.order != 6 {
+        return Err(format!("the order is 4 (G1) or 6 (G2), not {}", o.order));
+    }
+    let chosen: Vec<usize> = match &o.holes {
+        Some(list) => {
+            for &i in list {
+                if i == 0 || i > holes.len() {
+                    return Err(format!("hole {i} does not exist: the model has {} (numbered from 1)", holes.len()));
+                }
+            }
+            list.iter().map(|i| i - 1).collect()
+        }
+        None => (0..holes.len())
+            .filter(|&i| holes[i].kind == HoleKind::Simple)
+            .filter(|&i| o.max_edges.is_none_or(|n| holes[i].uses.len() <= n))
+            .collect(),
+    };
+    let size = m.brep.size();
+    let mut out = Vec::with_capacity(chosen.len());
+    for i in chosen {
+        let h = &holes[i];
+        let fail = |e: String| format!("hole {}: {e}", i + 1);
+        let opts = FillOptions { order: o.order, ..Default::default() };
+        let fill = fill_hole(&m.brep, h, &opts).map_err(|e| fail(e.to_string()))?;
+        let degree = if o.order == 6 { 5 } else { 3 };
+        let fo = FitOptions {
+            tolerance: Some(o.relative * size),
+            degree,
+            v_breaks: fill.fill.corner_parameters(),
+            ..Default::default()
+        };
+        let (surface, fit) = fit_surface(fill.fill.patch().as_ref(), &fo).map_err(|e| fail(e.to_string()))?;
+        if !fit.max_deviation.is_finite() {
+            return Err(fail(format!("the fit's measured deviation {} is not finite", fit.max_deviation)));
+        }
+        let seam = measure_seam(&m.brep, &h.faces(), &surface, 400, size);
+        out.push(FilledHole { index: i + 1, fill, surface, fit, seam });
+    }
+    Ok(out)
+}
+
+/// Writes `m` with the filled holes sewn in to `out` (atomically).
+pub fn write_filled(m: &StepModel, holes: &[Hole], filled: &[FilledHole], out: &Path) -> Result<(), String> {
+    let size = m.brep.size();
+    // a shell is closed when all its holes are filled
+    let shell_of = |h: &Hole| m.brep.faces[h.uses[0].face].shell;
+    let faces: Vec<SewnFace> = filled
+        .iter()
+        .map(|f| {
+            let h = &holes[f.index - 1];
+            let closes_shell = holes
+                .iter()
+                .enumerate()
+                .filter(|(_, g)| shell_of(g) == shell_of(h))
+                .all(|(j, _)| filled.iter().any(|x| x.index == j + 1));
+            SewnFace { surface: &f.surface, hole: h, closes_shell }
+        })
+        .collect();
+    // the new faces' corners meet the hole's vertices within the fit's tolerance and the
+    // file's edges' offset from their faces
+    let edge_offset = filled.iter().fold(0.0, |a, f| max_nan(a, f.fill.edge_offset));
+    let tol = 10.0 * (1e-7 * size + edge_offset);
+    let bytes = sewn_step(m, &faces, tol)?;
+    write_atomic(out, |w| w.write_all(&bytes)).map_err(|e| format!("{}: {e}", out.display()))
+}
