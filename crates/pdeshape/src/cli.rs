@@ -20,7 +20,9 @@ pub struct Cli {
     quiet: bool,
     /// Raise or lower a cap on what a scene may ask for: order (PDE order, default 64),
     /// modes (Fourier modes, sine terms, bubbles, solid terms; 512), collocation (points
-    /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096).
+    /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096),
+    /// scene (MiB of a scene file; 16), model (MiB of a STEP model; 256), entities (of a
+    /// STEP model; 4000000).
     #[arg(long = "limit", global = true, value_name = "CAP=VALUE", value_parser = limit)]
     limit: Vec<String>,
     /// Longest time in seconds: for build, check, sample and render the whole command
@@ -100,6 +102,38 @@ enum Command {
         /// Override a parameter: NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
+    },
+    /// List the holes of a model (STEP): the loops of its free boundary, with their
+    /// edges, the faces around, length, bounding box and whether the faces meet G1 at
+    /// each corner.
+    Holes {
+        /// The model (.step or .stp).
+        model: PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Fill the holes of a model (STEP) with fills of order 4 (G1) or 6 (G2) and write the
+    /// model back with the new faces sewn in (every input face unchanged).
+    FillHoles {
+        /// The model (.step or .stp).
+        model: PathBuf,
+        /// The output model (.step or .stp).
+        #[arg(short, long)]
+        out: PathBuf,
+        /// 4: G1 to the faces around (faces of degree 3); 6: G2 (degree 5).
+        #[arg(long, default_value_t = 4, value_parser = fill_order)]
+        order: usize,
+        /// The holes to fill, by their numbers in `holes` (default: every hole).
+        #[arg(long, value_delimiter = ',', conflicts_with = "max_edges")]
+        holes: Option<Vec<usize>>,
+        /// Leave holes of more edges open.
+        #[arg(long)]
+        max_edges: Option<usize>,
+        /// The new faces' measured maximum deviation from their fills, relative to the
+        /// model's size (default 1e-7).
+        #[arg(long, value_parser = positive)]
+        relative_tolerance: Option<f64>,
     },
     /// Render a scene to PNG.
     Render {
@@ -244,6 +278,15 @@ fn setting(s: &str) -> Result<(String, f64), String> {
     Ok((k.trim().to_string(), x))
 }
 
+/// A fill's order: 4 or 6.
+fn fill_order(s: &str) -> Result<usize, String> {
+    match s {
+        "4" => Ok(4),
+        "6" => Ok(6),
+        _ => Err(format!("`{}`: the order is 4 (G1) or 6 (G2)", clip(s, 20))),
+    }
+}
+
 /// A `--limit CAP=VALUE` setting, checked as clap parses it.
 fn limit(s: &str) -> Result<String, String> {
     Limits::default().apply(s).map(|()| s.to_string())
@@ -268,9 +311,15 @@ pub fn run() -> i32 {
         // serve applies its limit to each request
         (Command::Serve { .. }, _) => 0.0,
         (_, Some(t)) => t,
-        (Command::Build { .. } | Command::Check { .. } | Command::Sample { .. } | Command::Render { .. }, None) => {
-            DEFAULT_MAX_TIME
-        }
+        (
+            Command::Build { .. }
+            | Command::Check { .. }
+            | Command::Sample { .. }
+            | Command::Render { .. }
+            | Command::Holes { .. }
+            | Command::FillHoles { .. },
+            None,
+        ) => DEFAULT_MAX_TIME,
         _ => 0.0,
     };
     let result = if max_time > 0.0 { within(max_time, move || execute(cli, limits)) } else { execute(cli, limits) };
@@ -400,6 +449,14 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 eprintln!("wrote {}", out.display());
             }
             Ok(())
+        }
+        Command::Holes { model, json } => crate::holes::list(&model, json, &limits),
+        Command::FillHoles { model, out, order, holes, max_edges, relative_tolerance } => {
+            let mut o = pdeshape_io::holes::FillHolesOptions { order, holes, max_edges, ..Default::default() };
+            if let Some(r) = relative_tolerance {
+                o.relative = r;
+            }
+            crate::holes::fill(&model, &out, &o, &limits, quiet)
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, quiet, limits),
         Command::Bench { scaling: Some(dir), runs, max_side, .. } => {

@@ -7,6 +7,7 @@ mod check;
 mod cli;
 mod clip;
 mod gallery;
+mod holes;
 mod sample;
 mod serve;
 mod usage;

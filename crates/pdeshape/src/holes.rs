@@ -1,0 +1,103 @@
+//! `holes` and `fill-holes`: a model's free boundary listed, and filled with the new
+//! faces sewn in. The input's kind is decided by its extension.
+
+use crate::usage::Usage;
+use anyhow::{Result, anyhow};
+use pdeshape_core::brep::holes;
+use pdeshape_core::limits::Limits;
+use pdeshape_io::holes::{FillHolesOptions, fill_holes, holes_report, write_filled};
+use pdeshape_io::import::step::{StepModel, read_step};
+use std::path::Path;
+
+fn is_step(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("step") || e.eq_ignore_ascii_case("stp"))
+}
+
+fn load(path: &Path, limits: &Limits) -> Result<StepModel> {
+    if !is_step(path) {
+        return Err(Usage(format!(
+            "{}: the model must be a STEP file (.step or .stp); holes of triangle meshes are not read yet",
+            path.display()
+        ))
+        .into());
+    }
+    Ok(read_step(path, limits)?)
+}
+
+/// `pdeshape holes MODEL [--json]`.
+pub fn list(path: &Path, json: bool, limits: &Limits) -> Result<()> {
+    let m = load(path, limits)?;
+    let hs = holes(&m.brep);
+    let r = holes_report(&m, &hs);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {} shell(s), {} faces, {} edges; lengths in {}; {} loop(s) of free edges",
+        r.file,
+        r.shells,
+        r.faces,
+        r.edges,
+        r.unit,
+        r.holes.len()
+    );
+    for u in &r.unsupported {
+        println!("  not read (written back as it is): {u}");
+    }
+    for h in &r.holes {
+        let edges: Vec<String> = h.edges.iter().map(|e| format!("#{e}")).collect();
+        let faces: Vec<String> = h.faces.iter().map(|e| format!("#{e}")).collect();
+        let worst = h.corners.iter().fold(0.0, |a: f64, c| pdeshape_core::num::max_nan(a, c.1));
+        println!(
+            "hole {}: {}, {} edge(s) [{}], faces [{}], length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}], corners {} (largest angle {:.3e} rad)",
+            h.index,
+            h.kind,
+            h.edges.len(),
+            edges.join(" "),
+            faces.join(" "),
+            h.length,
+            h.bbox[0][0],
+            h.bbox[0][1],
+            h.bbox[0][2],
+            h.bbox[1][0],
+            h.bbox[1][1],
+            h.bbox[1][2],
+            if h.g1_corners { "G1" } else { "not all G1" },
+            worst
+        );
+    }
+    Ok(())
+}
+
+/// `pdeshape fill-holes MODEL -o OUT [--order 4|6] [--holes I,J | --max-edges N]`.
+pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quiet: bool) -> Result<()> {
+    if !is_step(out) {
+        return Err(Usage(format!("{}: the output must be a STEP file (.step or .stp)", out.display())).into());
+    }
+    let m = load(path, limits)?;
+    let hs = holes(&m.brep);
+    let filled = fill_holes(&m, &hs, o).map_err(|e| anyhow!("{}: {e}", m.file))?;
+    if filled.is_empty() {
+        return Err(anyhow!("{}: no hole to fill (`pdeshape holes` lists the loops)", m.file));
+    }
+    write_filled(&m, &hs, &filled, out).map_err(|e| anyhow!(e))?;
+    if !quiet {
+        for f in &filled {
+            let s = &f.seam;
+            let g2 = if o.order == 6 {
+                format!(", curvature gap {:.3e} (relative {:.3e})", s.curvature_gap, s.relative_curvature_gap)
+            } else {
+                String::new()
+            };
+            eprintln!(
+                "hole {}: order {}, {} × {} control points, measured deviation {:.3e}; seam gap {:.3e}, G1 {:.3e} rad{g2} ({} points)",
+                f.index, o.order, f.fit.points.0, f.fit.points.1, f.fit.max_deviation, s.gap, s.angle, s.samples
+            );
+        }
+        eprintln!("wrote {}", out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,86 @@
+"""Writes the STEP models of the `holes`/`fill-holes` tests with OpenCASCADE (the CI venv's
+`cadquery-ocp`): each a solid with faces removed, so that the removed faces leave holes.
+
+    python make_models.py    # in this directory; rewrites the .step files
+
+- cylinder-open.step: a cylinder (radius 1, height 2) without its top: one hole bounded by
+  one closed circular edge on a cylindrical face.
+- rounded-box-corners.step: a 2 × 2 × 2 box with every edge rounded (radius 0.4) without
+  its eight spherical corner faces: eight three-sided holes between cylindrical faces.
+- loft-open.step: a loft through a circle, an ellipse and a smaller circle (B-spline
+  faces) without its top: one hole bounded by one closed edge on a B-spline face.
+
+Made by this project with OpenCASCADE; no third-party content.
+"""
+
+from OCP.BRep import BRep_Builder
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+from OCP.GeomAbs import GeomAbs_Plane, GeomAbs_Sphere
+from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Shell
+from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Elips, gp_Pnt
+
+
+def faces(shape):
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        yield TopoDS.Face(ex.Current())
+        ex.Next()
+
+
+def shell_without(shape, drop):
+    """The faces of `shape` but those `drop(face)` picks, as one open shell."""
+    b = BRep_Builder()
+    sh = TopoDS_Shell()
+    b.MakeShell(sh)
+    for f in faces(shape):
+        if not drop(f):
+            b.Add(sh, f)
+    return sh
+
+
+def write(shape, path):
+    w = STEPControl_Writer()
+    w.Transfer(shape, STEPControl_AsIs)
+    assert w.Write(path) == 1, path
+
+
+def top_plane(z):
+    def drop(f):
+        s = BRepAdaptor_Surface(f)
+        return s.GetType() == GeomAbs_Plane and abs(s.Plane().Location().Z() - z) < 1e-9
+    return drop
+
+
+def main():
+    cyl = BRepPrimAPI_MakeCylinder(1.0, 2.0).Shape()
+    write(shell_without(cyl, top_plane(2.0)), "cylinder-open.step")
+
+    box = BRepPrimAPI_MakeBox(2.0, 2.0, 2.0).Shape()
+    fillet = BRepFilletAPI_MakeFillet(box)
+    ex = TopExp_Explorer(box, TopAbs_EDGE)
+    while ex.More():
+        fillet.Add(0.4, TopoDS.Edge(ex.Current()))
+        ex.Next()
+    rounded = fillet.Shape()
+    write(shell_without(rounded, lambda f: BRepAdaptor_Surface(f).GetType() == GeomAbs_Sphere), "rounded-box-corners.step")
+
+    def wire(curve):
+        return BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(curve).Edge()).Wire()
+
+    loft = BRepOffsetAPI_ThruSections(True, False)
+    loft.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0)))
+    loft.AddWire(wire(gp_Elips(gp_Ax2(gp_Pnt(0, 0, 1), gp_Dir(0, 0, 1)), 1.3, 0.8)))
+    loft.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 2), gp_Dir(0, 0, 1)), 0.7)))
+    loft.Build()
+    write(shell_without(loft.Shape(), top_plane(2.0)), "loft-open.step")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,238 @@
+//! `pdeshape holes` and `fill-holes` on STEP models that OpenCASCADE wrote
+//! (`tests/data/step/make_models.py`; OpenCASCADE reads the filled models back in
+//! `crates/pdeshape-io/tests/occt/test_fill_holes.py`): the free boundary against closed
+//! forms, the filled model keeping every input entity, its seams as measured, and the
+//! refusals of bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn model(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/step").join(name)
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pdeshape")).args(args).output().unwrap()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    let o = run(&["holes", path.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// The cylinder without its top: one hole, one closed circular edge of length 2π on the
+/// cylindrical face; the rounded box without its corners: eight holes of three quarter
+/// circles of radius 0.4 (length 3 · π/2 · 0.4 each) between cylinders meeting G1.
+#[test]
+fn holes_are_the_free_boundary() {
+    let c = json(&model("cylinder-open.step"));
+    assert_eq!(c["unit"], "millimetre");
+    assert_eq!((c["faces"].as_u64(), c["edges"].as_u64()), (Some(2), Some(3)));
+    let h = &c["holes"].as_array().unwrap()[..];
+    assert_eq!(h.len(), 1);
+    assert_eq!(h[0]["kind"], "hole");
+    assert_eq!(h[0]["edges"], serde_json::json!([21]));
+    // a circle's |C'| is constant: the quadrature is exact but for round-off
+    assert!((h[0]["length"].as_f64().unwrap() - std::f64::consts::TAU).abs() < 1e-13, "{}", h[0]["length"]);
+    assert_eq!(h[0]["bbox"][1][2].as_f64(), Some(2.0));
+
+    let b = json(&model("rounded-box-corners.step"));
+    let h = b["holes"].as_array().unwrap();
+    assert_eq!(h.len(), 8);
+    for x in h {
+        assert_eq!(x["edges"].as_array().unwrap().len(), 3);
+        assert_eq!(x["faces"].as_array().unwrap().len(), 3);
+        let want = 3.0 * std::f64::consts::FRAC_PI_2 * 0.4;
+        assert!((x["length"].as_f64().unwrap() - want).abs() < 1e-13);
+        // cylinders of one radius meet tangentially at the corner: angles of round-off
+        for c in x["corners"].as_array().unwrap() {
+            assert!(c[1].as_f64().unwrap() < 1e-14, "{c}");
+        }
+        assert_eq!(x["g1_corners"], true);
+    }
+}
+
+/// Entity texts of a STEP file's DATA section by id.
+fn entities(text: &str) -> std::collections::BTreeMap<u64, String> {
+    let data = &text[text.find("DATA;").unwrap() + 5..text.rfind("ENDSEC;").unwrap()];
+    data.split(";\n")
+        .map(str::trim)
+        .filter(|s| s.starts_with('#'))
+        .map(|s| {
+            let (id, body) = s.split_once('=').unwrap();
+            (id.trim()[1..].parse().unwrap(), body.trim().to_string())
+        })
+        .collect()
+}
+
+fn figures(stderr: &str) -> Vec<(f64, f64)> {
+    // "seam gap G, G1 A rad"
+    stderr
+        .lines()
+        .filter_map(|l| {
+            let g = l.split("seam gap ").nth(1)?.split(',').next()?.parse().ok()?;
+            let a = l.split("G1 ").nth(1)?.split(' ').next()?.parse().ok()?;
+            Some((g, a))
+        })
+        .collect()
+}
+
+/// Every hole of the rounded box filled: each input entity comes back with the same
+/// text but the shell (which gains the new faces and is closed) and its surface model and
+/// representation (now a solid); the output has no holes left; the seams, measured on
+/// the written faces against the exact cylinders, are within what the fit gives.
+#[test]
+fn filled_holes_are_sewn_into_the_unchanged_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("filled.step");
+    let input = model("rounded-box-corners.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let before = entities(&std::fs::read_to_string(&input).unwrap());
+    let after = entities(&std::fs::read_to_string(&out).unwrap());
+    let changed: Vec<u64> = before.iter().filter(|(id, body)| after.get(id) != Some(body)).map(|(id, _)| *id).collect();
+    let shell = before.iter().find(|(_, b)| b.starts_with("OPEN_SHELL")).map(|(id, _)| *id).unwrap();
+    assert_eq!(changed.len(), 3, "{changed:?}");
+    assert!(after[&shell].starts_with("CLOSED_SHELL"));
+    assert!(after.values().any(|b| b.starts_with(&format!("MANIFOLD_SOLID_BREP('',#{shell})"))));
+    assert!(after.values().any(|b| b.starts_with("ADVANCED_BREP_SHAPE_REPRESENTATION")));
+    assert_eq!(after.values().filter(|b| b.starts_with("ADVANCED_FACE")).count(), 18 + 8);
+    // the new faces use the holes' own edges
+    let holes = json(&input);
+    for h in holes["holes"].as_array().unwrap() {
+        for e in h["edges"].as_array().unwrap() {
+            let uses =
+                after.values().filter(|b| b.starts_with("ORIENTED_EDGE") && b.contains(&format!("#{e},"))).count();
+            assert_eq!(uses, 2, "edge #{e}");
+        }
+    }
+    assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
+    let f = figures(&err);
+    assert_eq!(f.len(), 8, "{err}");
+    for (gap, angle) in f {
+        // the fit holds the faces to 1e-7 of the model's size (3.5e-7); measured 1.9e-8 and
+        // 8.4e-6 rad
+        assert!(gap < 1e-7 && angle < 2e-5, "{err}");
+    }
+}
+
+/// Order 6 on the cylinder's open top (one closed edge, cut into three pieces on one
+/// face): the normal curvature across the seam is the cylinder's (zero along its axis) to
+/// round-off of the fit of degree 5 (measured 6.9e-13, relative 2.4e-12).
+#[test]
+fn order_six_keeps_the_curvature() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.step");
+    let input = model("cylinder-open.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--order", "6"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let rel: f64 = err.split("(relative ").nth(1).unwrap().split(')').next().unwrap().parse().unwrap();
+    assert!(rel < 1e-10, "{err}");
+}
+
+fn refused(args: &[&str], code: i32, words: &[&str]) {
+    let o = run(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");
+    for w in words {
+        assert!(err.contains(w), "{args:?}: `{w}` not in {err}");
+    }
+}
+
+/// A copy of the cylinder model with `from` replaced by `to` in its text.
+fn edited(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(model("cylinder-open.step")).unwrap();
+    assert!(text.contains(from), "{from}");
+    let p = dir.join(name);
+    std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
+    p
+}
+
+#[test]
+fn bad_models_are_refused_with_the_entity_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out.step");
+    let o = out.to_str().unwrap();
+    let s = |p: &PathBuf| p.to_str().unwrap().to_string();
+    // not Part 21
+    let junk = d.join("junk.step");
+    std::fs::write(&junk, "solid x\nendsolid\n").unwrap();
+    refused(&["holes", &s(&junk)], 1, &["junk.step", "not a STEP"]);
+    // a reference to an entity the file does not define
+    let dangling =
+        edited(d, "dangling.step", "#21 = EDGE_CURVE('',#22,#22,#24,.T.);", "#21 = EDGE_CURVE('',#22,#22,#9999,.T.);");
+    refused(&["holes", &s(&dangling)], 1, &["dangling.step:33", "#21 EDGE_CURVE", "#9999"]);
+    // a loop whose edges do not meet
+    let open = edited(d, "open.step", "#43 = EDGE_CURVE('',#44,#22,#46,.T.);", "#43 = EDGE_CURVE('',#44,#44,#46,.T.);");
+    refused(&["holes", &s(&open)], 1, &["#19 EDGE_LOOP", "does not close"]);
+    // an open edge of no length
+    let zero = edited(
+        d,
+        "zero.step",
+        "#43 = EDGE_CURVE('',#44,#22,#46,.T.);",
+        "#43 = EDGE_CURVE('',#44,#1000,#46,.T.);\n#1000 = VERTEX_POINT('',#45);",
+    );
+    refused(&["holes", &s(&zero)], 1, &["#43 EDGE_CURVE", "zero length"]);
+    // a negative radius
+    let radius =
+        edited(d, "radius.step", "#31 = CYLINDRICAL_SURFACE('',#32,1.);", "#31 = CYLINDRICAL_SURFACE('',#32,-1.);");
+    refused(&["holes", &s(&radius)], 1, &["#31 CYLINDRICAL_SURFACE", "not positive"]);
+    // caps
+    let cyl = s(&model("cylinder-open.step"));
+    refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);
+    // usage: not a STEP file, a missing hole, an output that is not STEP: nothing written
+    refused(&["holes", "model.obj"], 2, &["STEP"]);
+    refused(&["fill-holes", &cyl, "-o", o, "--holes", "2"], 1, &["hole 2 does not exist"]);
+    refused(&["fill-holes", &cyl, "-o", &s(&d.join("x.obj"))], 2, &["output must be a STEP"]);
+    refused(&["fill-holes", &cyl, "-o", o, "--order", "5"], 2, &["4 (G1) or 6 (G2)"]);
+    assert!(!out.exists() && !d.join("x.obj").exists());
+}
+
+/// A face on a surface of a kind that is not read is kept and listed; the hole along it is
+/// refused by name, and nothing is written.
+#[test]
+fn unsupported_geometry_is_listed_and_its_holes_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = edited(
+        dir.path(),
+        "rev.step",
+        "#31 = CYLINDRICAL_SURFACE('',#32,1.);",
+        "#31 = SURFACE_OF_REVOLUTION('',#25,#32);",
+    );
+    let j = json(&p);
+    assert_eq!(j["unsupported"], serde_json::json!(["#17: #31 SURFACE_OF_REVOLUTION"]));
+    let out = dir.path().join("o.step");
+    refused(&["fill-holes", p.to_str().unwrap(), "-o", out.to_str().unwrap()], 1, &["hole 1", "face #17", "not read"]);
+    assert!(!out.exists());
+}
+
+/// Length units: an SI unit with its prefix, and a conversion-based inch (25.4 mm); the
+/// geometry stays in the file's unit.
+#[test]
+fn length_units_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let unit = |p: &Path| json(p)["unit"].as_str().unwrap().to_string();
+    let metre = edited(dir.path(), "m.step", "SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)");
+    assert_eq!(unit(&metre), "metre");
+    let inch = edited(
+        dir.path(),
+        "in.step",
+        "#98 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );",
+        "#98 = ( CONVERSION_BASED_UNIT('INCH',#990) LENGTH_UNIT() NAMED_UNIT(#991) );\n#990 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#992);\n#991 = DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);\n#992 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );",
+    );
+    let j = json(&inch);
+    assert_eq!(j["unit"], "inch");
+    assert!((j["holes"][0]["length"].as_f64().unwrap() - std::f64::consts::TAU).abs() < 1e-13);
+    // a second, different length unit in the same file is refused
+    let two = edited(
+        dir.path(),
+        "two.step",
+        "#98 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );",
+        "#98 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#993 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#994)) REPRESENTATION_CONTEXT('','') );\n#994 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.METRE.) );",
+    );
+    refused(&["holes", two.to_str().unwrap()], 1, &["two length units", "millimetre", "metre"]);
+}
