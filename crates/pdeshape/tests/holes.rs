@@ -181,6 +181,14 @@ fn bad_models_are_refused_with_the_entity_and_line() {
     let radius =
         edited(d, "radius.step", "#31 = CYLINDRICAL_SURFACE('',#32,1.);", "#31 = CYLINDRICAL_SURFACE('',#32,-1.);");
     refused(&["holes", &s(&radius)], 1, &["#31 CYLINDRICAL_SURFACE", "not positive"]);
+    // a curve on a surface that is its own 3D curve (a cycle)
+    let cycle = edited(
+        d,
+        "cycle.step",
+        "#24 = SURFACE_CURVE('',#25,(#30),.PCURVE_S1.);",
+        "#24 = SURFACE_CURVE('',#24,(#30),.PCURVE_S1.);",
+    );
+    refused(&["holes", &s(&cycle)], 1, &["#24 SURFACE_CURVE", "a cycle?"]);
     // caps
     let cyl = s(&model("cylinder-open.step"));
     refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);

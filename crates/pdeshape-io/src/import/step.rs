@@ -295,9 +295,9 @@ impl<'g> Reader<'g> {
                 let Some(RawEntity::Complex { parts, .. }) = self.g.get(*uid) else { continue };
                 let has = |n: &str| parts.iter().any(|p| p.name == n);
                 if has("LENGTH_UNIT") {
-                    lengths.push(self.unit_size(*uid, parts, "METRE", *id)?);
+                    lengths.push(self.unit_size(*uid, parts, "METRE", 0)?);
                 } else if has("PLANE_ANGLE_UNIT") {
-                    angles.push(self.unit_size(*uid, parts, "RADIAN", *id)?.1);
+                    angles.push(self.unit_size(*uid, parts, "RADIAN", 0)?.1);
                 }
             }
         }
@@ -318,8 +318,18 @@ impl<'g> Reader<'g> {
     }
 
     /// An SI unit with its prefix, or a conversion-based unit (inch, degree): name and
-    /// size in the SI base unit `base`.
-    fn unit_size(&self, id: u64, parts: &[RawEntityPart], base: &str, _ctx: u64) -> Result<(String, f64), StepError> {
+    /// size in the SI base unit `base`. `depth` counts the conversions followed (a cycle
+    /// of them is refused).
+    fn unit_size(
+        &self,
+        id: u64,
+        parts: &[RawEntityPart],
+        base: &str,
+        depth: usize,
+    ) -> Result<(String, f64), StepError> {
+        if depth > 8 {
+            return Err(self.err_at(id, "more than 8 unit conversions in a row (a cycle?)"));
+        }
         if let Some(si) = parts.iter().find(|p| p.name == "SI_UNIT") {
             let prefix = match si.attributes.first() {
                 Some(Attribute::Enum(p)) => p.clone(),
@@ -356,7 +366,7 @@ impl<'g> Reader<'g> {
             let value = self.real(m, self.attr(m, attrs, 0)?, "the measure")?;
             let of = self.reference(m, self.attr(m, attrs, 1)?, "the unit")?;
             let inner = match self.entity(of, m)? {
-                RawEntity::Complex { parts, .. } => self.unit_size(of, parts, base, _ctx)?.1,
+                RawEntity::Complex { parts, .. } => self.unit_size(of, parts, base, depth + 1)?.1,
                 _ => return Err(self.err_at(of, "a unit is expected")),
             };
             // finite: `real` refuses others
@@ -489,7 +499,7 @@ impl<'g> Reader<'g> {
         let same_sense = self.boolean(id, self.attr(id, attrs, 4)?, "same_sense")?;
         let vertices = [self.vertex(v0, id)?, self.vertex(v1, id)?];
         let (p0, p1) = (self.brep.vertices[vertices[0]].1, self.brep.vertices[vertices[1]].1);
-        let curve = match self.curve(cid, id)? {
+        let curve = match self.curve(cid, id, 0)? {
             Ok(c) => Some(c),
             Err(what) => {
                 self.unsupported.push((id, what));
@@ -620,6 +630,12 @@ impl<'g> Reader<'g> {
         if m.len() != k.len() {
             return Err(self.err_at(id, format!("{} multiplicities for {} knots", m.len(), k.len())));
         }
+        // the expanded vector is as long as the control points plus the degree plus one;
+        // a file cannot hold more points than entities
+        let total: i64 = m.iter().map(|x| if let Attribute::Integer(n) = x { (*n).clamp(0, 64) } else { 0 }).sum();
+        if total as usize > self.g.entities.len() + 26 {
+            return Err(self.err_at(id, format!("the multiplicities add up to {total}, more than the file has points")));
+        }
         let mut out = Vec::new();
         for (mi, ki) in m.iter().zip(k) {
             let Attribute::Integer(n) = mi else { return Err(self.err_at(id, "a multiplicity is not an integer")) };
@@ -695,7 +711,10 @@ impl<'g> Reader<'g> {
     }
 
     /// The curve, or (`Err`) the name of what is not supported.
-    fn curve(&self, id: u64, from: u64) -> Result<Result<EdgeCurve, String>, StepError> {
+    fn curve(&self, id: u64, from: u64, depth: usize) -> Result<Result<EdgeCurve, String>, StepError> {
+        if depth > 8 {
+            return Err(self.err_at(id, "more than 8 nested curves on surfaces or trimmed curves (a cycle?)"));
+        }
         let e = self.entity(id, from)?;
         let (kind, attrs) = match e {
             RawEntity::Simple { name, attributes, .. } => (name.as_str(), attributes.as_slice()),
@@ -711,7 +730,7 @@ impl<'g> Reader<'g> {
             // parameters come from the feet of the 3D curve)
             "SURFACE_CURVE" | "SEAM_CURVE" | "TRIMMED_CURVE" => {
                 let c = self.reference(id, self.attr(id, attrs, 1)?, "the basis curve")?;
-                self.curve(c, id)
+                self.curve(c, id, depth + 1)
             }
             "LINE" => {
                 let o = self.point(self.reference(id, self.attr(id, attrs, 1)?, "the point")?, id)?;
