@@ -286,7 +286,7 @@ impl<'g> Reader<'g> {
     fn units(&mut self) -> Result<(String, f64), StepError> {
         let mut lengths: Vec<(String, f64)> = Vec::new();
         let mut angles: Vec<f64> = Vec::new();
-        for (id, e) in &self.g.entities {
+        for e in self.g.entities.values() {
             let RawEntity::Complex { parts, .. } = e else { continue };
             let Some(ctx) = parts.iter().find(|p| p.name == "GLOBAL_UNIT_ASSIGNED_CONTEXT") else { continue };
             let Some(Attribute::List(units)) = ctx.attributes.first() else { continue };
