@@ -170,16 +170,21 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
     let mut out = SeamFigures { samples, ..Default::default() };
     let v1 = s.v.knots.last().copied().unwrap_or(1.0);
     let v0 = s.v.knots.first().copied().unwrap_or(0.0);
+    // each face's last foot seeds the next (a grid search for every point costs thousands
+    // of evaluations of a B-spline face)
+    let mut seeds: Vec<Option<[f64; 2]>> = vec![None; faces.len()];
     for i in 0..samples {
         let v = v0 + (v1 - v0) * (i as f64 + 0.5) / samples as f64;
         let d = s.derivatives(0.0, v, 2, 2);
         let p = d[0];
         // the nearest face around
         let mut best: Option<(f64, usize, [f64; 2])> = None;
-        for &fi in faces {
+        for (k, &fi) in faces.iter().enumerate() {
             let Some(fs) = &b.faces[fi].surface else { continue };
             let field = fs.field();
-            let Some(c) = foot_of(field.as_ref(), p, fs.invert_near(p), 0.0) else { continue };
+            let near = seeds[k].and_then(|c| foot_of(field.as_ref(), p, c, 0.0));
+            let Some(c) = near.or_else(|| foot_of(field.as_ref(), p, fs.invert_near(p), 0.0)) else { continue };
+            seeds[k] = Some(c);
             let dist = (field.eval(&c) - p).norm();
             if best.is_none_or(|x| dist < x.0) {
                 best = Some((dist, fi, c));
