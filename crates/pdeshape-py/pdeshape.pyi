@@ -17,6 +17,29 @@ class SceneError(Exception):
     key: str
     message: str
 
+class ModelError(Exception):
+    """A model file (STEP) that cannot be read or whose holes cannot be filled; ``str(e)``
+    names the file, line and entity."""
+
+def holes(path: Union[str, PathLike[str]], *, limits: Optional[Dict[str, int]] = None) -> Dict[str, Any]:
+    """The holes of a STEP model: the dict ``pdeshape holes MODEL --json`` prints."""
+    ...
+
+def fill_holes(
+    path: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    *,
+    order: int = 4,
+    holes: Optional[List[int]] = None,
+    max_edges: Optional[int] = None,
+    relative_tolerance: float = 1e-7,
+    limits: Optional[Dict[str, int]] = None,
+    time_limit: Optional[float] = None,
+) -> List[Dict[str, Any]]:
+    """Fills the model's holes (order 4: G1, 6: G2) and writes it to ``out`` with the new
+    faces sewn in; one dict of figures per filled hole."""
+    ...
+
 class Mesh:
     """A triangle mesh as numpy arrays (trimesh, pyvista, libigl take them directly)."""
 

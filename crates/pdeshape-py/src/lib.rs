@@ -623,6 +623,106 @@ impl Mesh {
     }
 }
 
+pyo3::create_exception!(
+    pdeshape,
+    ModelError,
+    PyException,
+    "A model file (STEP) that cannot be read or whose holes cannot be filled: `str(e)` is \
+     the CLI's message, naming the file, line and entity."
+);
+
+/// The caps of a `limits={...}` dict.
+fn limits_of(limits: Option<&Bound<'_, PyDict>>) -> PyResult<Limits> {
+    Ok(Scene::options(None, None, limits, None)?.limits)
+}
+
+/// A JSON value as the Python object `json.loads` makes of it.
+fn to_python(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    Ok(py.import("json")?.call_method1("loads", (v.to_string(),))?.unbind())
+}
+
+fn model_error(e: impl std::fmt::Display) -> PyErr {
+    ModelError::new_err(py_message(&e.to_string()))
+}
+
+/// The holes of a STEP model: the dict `pdeshape holes MODEL --json` prints (the loops of
+/// its free boundary, each with its edges, the faces around, length, bounding box and the
+/// angle between the faces at each corner).
+///
+/// >>> pdeshape.holes("part.step")["holes"][0]["edges"]
+/// [21]
+#[pyfunction]
+#[pyo3(signature = (path, *, limits=None))]
+fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyAny>> {
+    let limits = limits_of(limits)?;
+    let report = py.detach(|| {
+        let m = pdeshape_io::import::step::read_step(&path, &limits)?;
+        let hs = pdeshape_core::brep::holes(&m.brep);
+        Ok::<_, pdeshape_io::import::step::StepError>(pdeshape_io::holes::holes_report(&m, &hs))
+    });
+    let report = report.map_err(model_error)?;
+    to_python(py, &serde_json::to_value(&report).map_err(|e| PyRuntimeError::new_err(e.to_string()))?)
+}
+
+/// Fills the holes of the STEP model at `path` with fills of order 4 (G1) or 6 (G2) and
+/// writes it to `out` with the new faces sewn in, as `pdeshape fill-holes` does; returns
+/// one dict per filled hole (its number, the B-spline face's control points and measured
+/// deviation, and the seam's gap, normal angle and curvature gap measured on the written
+/// face). `holes` picks holes by their numbers in `pdeshape.holes` (from 1); `max_edges`
+/// leaves bigger loops open. Raises `ModelError` when the model cannot be read or an asked
+/// hole cannot be filled (nothing is written), `TimeoutError` past `time_limit` seconds.
+#[pyfunction]
+#[pyo3(signature = (path, out, *, order=4, holes=None, max_edges=None, relative_tolerance=1e-7, limits=None, time_limit=None))]
+#[allow(clippy::too_many_arguments)]
+fn fill_holes(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    out: std::path::PathBuf,
+    order: usize,
+    holes: Option<Vec<usize>>,
+    max_edges: Option<usize>,
+    relative_tolerance: f64,
+    limits: Option<&Bound<'_, PyDict>>,
+    time_limit: Option<f64>,
+) -> PyResult<Py<PyAny>> {
+    if order != 4 && order != 6 {
+        return Err(PyValueError::new_err(format!("order = {order}: 4 (G1) or 6 (G2)")));
+    }
+    let limits = limits_of(limits)?;
+    let seconds = self::time_limit(time_limit)?;
+    if !(relative_tolerance.is_finite() && relative_tolerance > 0.0) {
+        return Err(PyValueError::new_err(format!("relative_tolerance = {relative_tolerance}: a positive number")));
+    }
+    if holes.is_some() && max_edges.is_some() {
+        return Err(PyValueError::new_err("holes and max_edges do not go together: holes picks the holes itself"));
+    }
+    let o = pdeshape_io::holes::FillHolesOptions { order, holes, max_edges, relative: relative_tolerance };
+    let done = limited(py, seconds, "filling the holes", || -> Result<serde_json::Value, String> {
+        let m = pdeshape_io::import::step::read_step(&path, &limits).map_err(|e| e.to_string())?;
+        let hs = pdeshape_core::brep::holes(&m.brep);
+        let filled = pdeshape_io::holes::fill_holes(&m, &hs, &o).map_err(|e| format!("{}: {e}", m.file))?;
+        if filled.is_empty() {
+            return Err(format!("{}: no hole to fill", m.file));
+        }
+        pdeshape_io::holes::write_filled(&m, &hs, &filled, &out)?;
+        Ok(serde_json::Value::Array(
+            filled
+                .iter()
+                .map(|f| {
+                    serde_json::json!({
+                        "index": f.index,
+                        "order": order,
+                        "control_points": [f.fit.points.0, f.fit.points.1],
+                        "measured_deviation": f.fit.max_deviation,
+                        "seam": f.seam,
+                    })
+                })
+                .collect(),
+        ))
+    })?;
+    to_python(py, &done.map_err(model_error)?)
+}
+
 /// PDE-based shape design: exact PDE surfaces, blends and solids (Bloor–Wilson's PDE
 /// method and its successors) from Python.
 ///
@@ -643,6 +743,9 @@ fn pdeshape(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Patch>()?;
     m.add_class::<Mesh>()?;
     m.add("SceneError", m.py().get_type::<SceneError>())?;
+    m.add("ModelError", m.py().get_type::<ModelError>())?;
+    m.add_function(wrap_pyfunction!(holes, m)?)?;
+    m.add_function(wrap_pyfunction!(fill_holes, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -308,3 +308,36 @@ def test_the_sweep_example_runs_and_plots(tmp_path):
     out = tmp_path / "sweep.png"
     runpy.run_path(str(ROOT / "examples/python/sweep.py"), run_name="sweep")["main"](str(out))
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 10_000
+
+
+STEP = Path(__file__).resolve().parents[2] / "pdeshape" / "tests" / "data" / "step"
+
+
+def test_holes_and_fill_holes_of_a_step_model(tmp_path):
+    """The cylinder without its top: one hole of one closed edge of length 2π; filled at
+    order 6 the written model has no hole left and the seam figures are those of the CLI
+    (the fit's tolerance: gap and angle; the curvature across the rim matches to round-off)."""
+    r = pdeshape.holes(STEP / "cylinder-open.step")
+    assert r["unit"] == "millimetre"
+    assert [h["edges"] for h in r["holes"]] == [[21]]
+    assert abs(r["holes"][0]["length"] - 2 * math.pi) < 1e-13
+    out = tmp_path / "c.step"
+    done = pdeshape.fill_holes(STEP / "cylinder-open.step", out, order=6)
+    assert [d["index"] for d in done] == [1]
+    seam = done[0]["seam"]
+    assert seam["gap"] < 3e-7 and seam["angle"] < 3e-6 and seam["relative_curvature_gap"] < 1e-10
+    assert pdeshape.holes(out)["holes"] == []
+
+
+def test_bad_models_and_arguments_raise(tmp_path):
+    bad = tmp_path / "bad.step"
+    bad.write_text((STEP / "cylinder-open.step").read_text().replace("#31 = CYLINDRICAL_SURFACE('',#32,1.);", "#31 = CYLINDRICAL_SURFACE('',#32,-1.);"))
+    with pytest.raises(pdeshape.ModelError, match=r"bad.step:\d+: #31 CYLINDRICAL_SURFACE"):
+        pdeshape.holes(bad)
+    with pytest.raises(ValueError, match="4 \\(G1\\) or 6"):
+        pdeshape.fill_holes(STEP / "cylinder-open.step", tmp_path / "o.step", order=5)
+    with pytest.raises(pdeshape.ModelError, match="hole 2 does not exist"):
+        pdeshape.fill_holes(STEP / "cylinder-open.step", tmp_path / "o.step", holes=[2])
+    with pytest.raises(pdeshape.ModelError, match="limits=\\{'entities'"):
+        pdeshape.holes(STEP / "cylinder-open.step", limits={"entities": 10})
+    assert not (tmp_path / "o.step").exists()
