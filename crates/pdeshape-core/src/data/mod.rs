@@ -20,6 +20,7 @@ mod combine;
 mod expr_field;
 mod extension;
 pub mod fourier;
+mod memo_field;
 mod nurbs;
 mod trimline;
 
@@ -27,6 +28,7 @@ pub use bspline::{BSplineCurve, BSplineError};
 pub use combine::Combination;
 pub use expr_field::ExprField;
 pub use extension::EvenExtension;
+pub use memo_field::MemoField;
 pub use nurbs::{NurbsCurve, NurbsError, NurbsSurface};
 pub use trimline::Trimline;
 

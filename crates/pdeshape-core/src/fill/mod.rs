@@ -698,11 +698,16 @@ impl Fill {
         };
         let e2 = normal.cross(e1);
         let fixed = |centre: Vec3, rho: f64| -> FieldRef { Arc::new(Ring { centre, e1, e2, rho }) };
-        let mut conds =
-            vec![Condition { u: 0.0, order: 0, data: position.clone() }, Condition { u: 0.0, order: 1, data: cross }];
+        // the loop's data are asked at the same v by every cell of a grid (and cost much
+        // per point on CAD faces): kept per point
+        let memo = |f: FieldRef| -> FieldRef { Arc::new(crate::data::MemoField::new(f)) };
+        let mut conds = vec![
+            Condition { u: 0.0, order: 0, data: memo(position.clone()) },
+            Condition { u: 0.0, order: 1, data: memo(cross) },
+        ];
         if o.order == 6 {
             let second = Arc::new(LoopData { pieces, order: 2, blend: o.corner_blend });
-            conds.push(Condition { u: 0.0, order: 2, data: second });
+            conds.push(Condition { u: 0.0, order: 2, data: memo(second) });
         }
         // the pole's data, `X = P`, `X_u = −ρ (cos v e₁ + sin v e₂)`, order 6 also
         // `X_uu = σ n̄`: what the user did not set is chosen by least bending
