@@ -26,18 +26,17 @@ import time
 from pathlib import Path
 
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
 from OCP.GeomAbs import GeomAbs_C1, GeomAbs_G1
-from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.STEPControl import STEPControl_Reader
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS
 from OCP.gp import gp_Pnt, gp_Vec
 
 ROOT = Path(__file__).resolve().parents[3]
+sys.path.insert(0, str(ROOT / "crates/pdeshape-io/tests/occt"))
+from brep_geometry import edge_uses, faces, jet, normal_curvature  # noqa: E402
+
 DATA = ROOT / "crates/pdeshape/tests/data/step"
 BIN = os.environ.get("PDESHAPE_BIN", str(ROOT / "target/release/pdeshape"))
 # model, the hole's number in `pdeshape holes`, a point of the hole's box (to pick OCCT's edges)
@@ -52,30 +51,6 @@ def read(path):
     return r.OneShape()
 
 
-def faces(shape):
-    ex = TopExp_Explorer(shape, TopAbs_FACE)
-    while ex.More():
-        yield TopoDS.Face(ex.Current())
-        ex.Next()
-
-
-def edge_uses(shape):
-    groups = {}
-    for f in faces(shape):
-        ex = TopExp_Explorer(f, TopAbs_EDGE)
-        while ex.More():
-            e = TopoDS.Edge(ex.Current())
-            bucket = groups.setdefault(hash(e), [])
-            for g in bucket:
-                if g[0].IsSame(e):
-                    g[1].append(f)
-                    break
-            else:
-                bucket.append((e, [f]))
-            ex.Next()
-    return [g for b in groups.values() for g in b]
-
-
 def hole_edges(shape, near):
     """Free edges (one face) within 0.5 of `near`, with their faces."""
     out = []
@@ -87,29 +62,6 @@ def hole_edges(shape, near):
         if p.Distance(gp_Pnt(*near)) < 1.0:
             out.append((e, fs[0]))
     return out
-
-
-def jet(face_or_surf, p):
-    surf = BRep_Tool.Surface_s(face_or_surf)
-    proj = GeomAPI_ProjectPointOnSurf(p, surf)
-    u, v = proj.LowerDistanceParameters()
-    s = BRepAdaptor_Surface(face_or_surf)
-    pt, su, sv, suu, svv, suv = gp_Pnt(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
-    s.D2(u, v, pt, su, sv, suu, svv, suv)
-    n = su.Crossed(sv)
-    n.Normalize()
-    return proj.LowerDistance(), n, (su, sv, suu, svv, suv)
-
-
-def normal_curvature(d, n, t):
-    su, sv, suu, svv, suv = d
-    e, f, g = su.Dot(su), su.Dot(sv), sv.Dot(sv)
-    tu, tv = t.Dot(su), t.Dot(sv)
-    det = e * g - f * f
-    a, b = (g * tu - f * tv) / det, (e * tv - f * tu) / det
-    second = suu.Multiplied(a * a).Added(suv.Multiplied(2 * a * b)).Added(svv.Multiplied(b * b))
-    first = su.Multiplied(a).Added(sv.Multiplied(b))
-    return second.Dot(n) / first.Dot(first)
 
 
 def measure(pairs):
