@@ -85,6 +85,11 @@ pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quie
     }
     write_filled(&m, &hs, &filled, out).map_err(|e| anyhow!(e))?;
     if !quiet {
+        // loops not asked for, or not simple holes, stay open: say so
+        let r = holes_report(&m, &hs);
+        for h in r.holes.iter().filter(|h| !filled.iter().any(|f| f.index == h.index)) {
+            eprintln!("hole {}: left open ({}, {} edge(s))", h.index, h.kind, h.edges.len());
+        }
         for f in &filled {
             let s = &f.seam;
             let g2 = if o.order == 6 {

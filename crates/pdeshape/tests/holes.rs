@@ -109,6 +109,7 @@ fn filled_holes_are_sewn_into_the_unchanged_model() {
         }
     }
     assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
+    assert!(!err.contains("left open"), "{err}");
     let f = figures(&err);
     assert_eq!(f.len(), 8, "{err}");
     for (gap, angle) in f {
@@ -197,6 +198,12 @@ fn bad_models_are_refused_with_the_entity_and_line() {
     refused(&["fill-holes", &cyl, "-o", o, "--holes", "2"], 1, &["hole 2 does not exist"]);
     refused(&["fill-holes", &cyl, "-o", &s(&d.join("x.obj"))], 2, &["output must be a STEP"]);
     refused(&["fill-holes", &cyl, "-o", o, "--order", "5"], 2, &["4 (G1) or 6 (G2)"]);
+    // every hole has more edges than asked: nothing to fill
+    refused(
+        &["fill-holes", &s(&model("rounded-box-corners.step")), "-o", o, "--max-edges", "2"],
+        1,
+        &["no hole to fill"],
+    );
     assert!(!out.exists() && !d.join("x.obj").exists());
 }
 
@@ -243,4 +250,22 @@ fn length_units_are_read() {
         "#98 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#993 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#994)) REPRESENTATION_CONTEXT('','') );\n#994 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.METRE.) );",
     );
     refused(&["holes", two.to_str().unwrap()], 1, &["two length units", "millimetre", "metre"]);
+}
+
+/// Holes not asked for stay open and are named; the shell stays open (no solid).
+#[test]
+fn holes_not_asked_for_stay_open() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("one.step");
+    let input = model("rounded-box-corners.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--holes", "3"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    for k in [1, 2, 4, 5, 6, 7, 8] {
+        assert!(err.contains(&format!("hole {k}: left open (hole, 3 edge(s))")), "{err}");
+    }
+    assert!(!err.contains("hole 3: left open"));
+    assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 7);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("OPEN_SHELL") && !text.contains("CLOSED_SHELL") && !text.contains("MANIFOLD_SOLID_BREP"));
 }
