@@ -36,6 +36,7 @@ pub mod solves;
 pub mod spectral;
 pub mod taylor;
 pub mod trim;
+pub mod trimesh;
 mod vec3;
 
 pub use vec3::Vec3;

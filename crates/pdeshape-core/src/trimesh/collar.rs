@@ -1,0 +1,460 @@
+//! The surface around a mesh's hole, estimated from the vertices near its loop, and the
+//! loop as a curve on it.
+//!
+//! A hole's loop in a mesh zigzags along the triangles' edges, so the loop itself is no
+//! good as a parametrisation: the feet of nearby vertices on a zigzag jump. The collar is
+//! built around a smooth curve instead and the loop is then a curve on the collar.
+//!
+//! 1. **Spine.** `P(w)`: a periodic cubic spline on uniform breakpoints (a quarter as many
+//!    as the loop's vertices, 4 … 128) fitted by least squares to the loop's vertices at
+//!    their chord-length parameters; `L` its period.
+//! 2. **Parameters.** Every loop vertex and every vertex within `rings` rings of the loop
+//!    gets `w` = its foot on `P` (Newton on `(P(w) − x)·P′(w) = 0`, started from the best of
+//!    samples near the loop vertex it was reached from) and the signed distance
+//!    `s = ±|x − P(w)|`, positive on the mesh's side (`N × P′`, `N` the normal of the
+//!    triangle on the loop nearest its origin).
+//! 3. **Surface.** `C̄(s, w) = P(w) + s D₁(w) + s² D₂(w) + s³ D₃(w)`, `D_k` periodic cubic
+//!    splines on the spine's breakpoints, fitted by linear least squares to all those
+//!    vertices (a second-difference penalty of 10⁻⁶ of the mean diagonal keeps the `D_k`
+//!    determined where vertices are few). Noise and uneven sampling average out; the
+//!    residual is reported.
+//! 4. **The loop on it.** `σ(w)`: the periodic cubic spline through `(w_i, s_i)` of the
+//!    loop's vertices (their `w_i` must increase along the loop), and `R(w)` the periodic
+//!    spline through the residuals `x_i − C̄(s_i, w_i)`. The collar is
+//!    `C(s, w) = C̄(s, w) + R(w)` and the loop is the curve `(σ(w), w)` in its domain, so
+//!    `C(σ(w_i), w_i) = x_i` to round-off: a fill that meets the collar along this curve
+//!    passes through the loop's own vertices.
+//!
+//! **Orientation.** The loop runs with the mesh on its left, so the mesh's normal is
+//! `N ∝ C_w × C_s` near it; a collar whose `C_w × C_s` turns against the normals of the
+//! triangles on the loop folds, and is refused.
+//!
+//! Derivatives are exact: `∂ᵢ_s ∂ʲ_w C` from the splines' jets and the polynomial in `s`.
+
+use super::{MeshLoop, PeriodicSpline, TriMesh};
+use crate::Vec3;
+use crate::data::{Field, NurbsCurve, VecJet};
+use crate::jet::{Jet, JetShape};
+use crate::linalg::{LinalgError, SquareSolver};
+use crate::num::max_nan;
+use faer::Mat;
+use std::cmp::Ordering;
+
+/// `C(s, w) = P(w) + R(w) + Σ_{k=0}^{3} s^k D_k(w)`, `L`-periodic in `w` (slots `s, w`;
+/// constant in time).
+#[derive(Clone, Debug)]
+pub struct Collar {
+    spine: NurbsCurve,
+    d: [NurbsCurve; 4],
+    period: f64,
+}
+
+impl Field for Collar {
+    fn arity(&self) -> usize {
+        2
+    }
+
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let [os, ow, _] = shape.orders();
+        let (s, w) = (at[0], at.get(1).copied().unwrap_or(0.0).rem_euclid(self.period));
+        let cs = JetShape::new(&[ow]);
+        let curves: Vec<VecJet> = self.d.iter().chain([&self.spine]).map(|c| c.jet(&[w], cs)).collect();
+        let binom = |k: usize, i: usize| -> f64 { (1..=i).map(|r| (k + 1 - r) as f64 / r as f64).product() };
+        VecJet(std::array::from_fn(|q| {
+            let mut c = vec![0.0; shape.len()];
+            for i in 0..=os.min(3) {
+                for j in 0..=ow {
+                    let mut v: f64 =
+                        (i..=3).map(|k| binom(k, i) * s.powi((k - i) as i32) * curves[k].0[q].coeff([j, 0, 0])).sum();
+                    if i == 0 {
+                        v += curves[4].0[q].coeff([j, 0, 0]);
+                    }
+                    c[shape.index([i, j, 0])] = v;
+                }
+            }
+            Jet::from_coeffs(shape, c)
+        }))
+    }
+
+    fn is_constant_in(&self, slot: usize) -> bool {
+        slot >= 2
+    }
+}
+
+/// A curve `τ ↦ (σ(τ), τ)` in the collar's domain, `σ` an `L`-periodic spline (slot `τ`;
+/// components 0 and 1 are the collar's `s` and `w`).
+#[derive(Clone, Debug)]
+pub struct DomainLine {
+    sigma: NurbsCurve,
+    period: f64,
+}
+
+impl DomainLine {
+    /// The line `(σ(τ), τ)`, `σ` with control points `ctrl` on `basis` (period `L`).
+    pub fn new(basis: &PeriodicSpline, ctrl: &[f64]) -> Self {
+        let pts: Vec<Vec3> = ctrl.iter().map(|&c| Vec3::new(c, 0.0, 0.0)).collect();
+        let (a, b) = basis.domain();
+        DomainLine { sigma: basis.curve(&pts), period: b - a }
+    }
+
+    /// `σ(τ)`.
+    pub fn sigma(&self, tau: f64) -> f64 {
+        self.sigma.eval(&[tau.rem_euclid(self.period)]).x
+    }
+}
+
+impl Field for DomainLine {
+    fn arity(&self) -> usize {
+        1
+    }
+
+    fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+        let [o, _, _] = shape.orders();
+        let tau = at[0];
+        let sj = self.sigma.jet(&[tau.rem_euclid(self.period)], JetShape::new(&[o]));
+        let mut c0 = vec![0.0; shape.len()];
+        let mut c1 = vec![0.0; shape.len()];
+        for j in 0..=o {
+            c0[shape.index([j, 0, 0])] = sj.0[0].coeff([j, 0, 0]);
+        }
+        c1[0] = tau;
+        if o >= 1 {
+            c1[shape.index([1, 0, 0])] = 1.0;
+        }
+        VecJet([Jet::from_coeffs(shape, c0), Jet::from_coeffs(shape, c1), Jet::constant(shape, 0.0)])
+    }
+
+    fn is_constant_in(&self, slot: usize) -> bool {
+        slot >= 1
+    }
+}
+
+/// A fitted collar with what the fit found.
+#[derive(Clone, Debug)]
+pub struct CollarFit {
+    /// The collar.
+    pub collar: Collar,
+    /// The loop vertices' `(s_i, w_i)`, `w_i` increasing from `w₀` within one period.
+    pub params: Vec<(f64, f64)>,
+    /// The period `L`.
+    pub period: f64,
+    /// Vertices fitted (the loop's and those within `rings` rings of it).
+    pub points: usize,
+    /// Control points of each `D_k`.
+    pub controls: usize,
+    /// The spine's basis (fewer control points, for smooth curves along the loop).
+    pub spine_basis: PeriodicSpline,
+    /// The largest `s` among them.
+    pub width: f64,
+    /// Root mean square distance of the fitted vertices from `C̄`.
+    pub rms: f64,
+    /// The largest.
+    pub max_residual: f64,
+    /// The largest `|C(s_i, w_i) − x_i|` at the loop's vertices.
+    pub loop_residual: f64,
+    /// 2-norm condition number of the least-squares normal matrix.
+    pub cond: f64,
+}
+
+/// Why a collar is not fitted.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CollarError {
+    /// Too few vertices near the loop.
+    #[error("only {points} vertices lie within {rings} rings of the loop (at least {needed} are needed)")]
+    TooFewPoints {
+        /// Found.
+        points: usize,
+        /// Rings searched.
+        rings: usize,
+        /// Needed.
+        needed: usize,
+    },
+    /// Two consecutive loop vertices coincide.
+    #[error("loop vertices {0} and {1} coincide")]
+    Coincident(u32, u32),
+    /// A spline through the loop failed.
+    #[error("the spline through the loop's vertices is singular")]
+    Interpolation,
+    /// The loop's vertices do not follow each other along the spine.
+    #[error("the loop turns back on itself near vertex {0} (its feet on the smoothed loop do not increase)")]
+    NotMonotone(u32),
+    /// The least-squares system.
+    #[error("the collar's least squares: {0}")]
+    Singular(#[from] LinalgError),
+    /// The collar turns against the mesh.
+    #[error(
+        "the surface fitted around the loop folds near vertex {vertex} (its normal turns against the mesh's by {angle:.3} rad)"
+    )]
+    Folds {
+        /// The loop vertex.
+        vertex: u32,
+        /// The angle between the collar's and the triangle's normal.
+        angle: f64,
+    },
+}
+
+/// The vertex neighbours of every vertex of `m`.
+pub fn adjacency(m: &TriMesh) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); m.positions.len()];
+    for &[a, b, c] in &m.triangles {
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            adj[x as usize].push(y);
+            adj[y as usize].push(x);
+        }
+    }
+    for l in &mut adj {
+        l.sort_unstable();
+        l.dedup();
+    }
+    adj
+}
+
+/// Solves the penalised normal equations `(AᵀA + λ D) X = Aᵀ B` of a periodic spline fit:
+/// `rows` gives each data row's non-zero columns and values and its right-hand side.
+fn penalised_fit(
+    nc: usize,
+    blocks: usize,
+    rows: impl Iterator<Item = (Vec<(usize, f64)>, Vec3)>,
+) -> Result<(Mat<f64>, f64), LinalgError> {
+    let mut g = Mat::<f64>::zeros(nc, nc);
+    let mut r = Mat::<f64>::zeros(nc, 3);
+    for (cols, d) in rows {
+        for &(ca, va) in &cols {
+            for &(cb, vb) in &cols {
+                g[(ca, cb)] += va * vb;
+            }
+            for c in 0..3 {
+                r[(ca, c)] += va * d[c];
+            }
+        }
+    }
+    let trace: f64 = (0..nc).map(|i| g[(i, i)]).sum::<f64>() / nc as f64;
+    let lambda = 1e-6 * trace;
+    let m = nc / blocks;
+    for k in 0..blocks {
+        for j in 0..m {
+            let idx = [(j + m - 1) % m, j, (j + 1) % m].map(|i| k * m + i);
+            let coef = [1.0, -2.0, 1.0];
+            for a in 0..3 {
+                for b in 0..3 {
+                    g[(idx[a], idx[b])] += lambda * coef[a] * coef[b];
+                }
+            }
+        }
+    }
+    let solver = SquareSolver::new(&g, 1e13)?;
+    Ok((solver.solve(&r), solver.cond()))
+}
+
+fn column(sol: &Mat<f64>, range: std::ops::Range<usize>, scale: f64) -> Vec<Vec3> {
+    range.map(|i| Vec3::new(sol[(i, 0)], sol[(i, 1)], sol[(i, 2)]) * scale).collect()
+}
+
+/// Fits the collar of loop `lp` of `m` to the vertices within `rings` rings of it
+/// (`adj` from [`adjacency`]).
+pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) -> Result<CollarFit, CollarError> {
+    let n = lp.vertices.len();
+    let x: Vec<Vec3> = lp.vertices.iter().map(|&i| m.positions[i as usize]).collect();
+    let mut chord = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    for i in 0..n {
+        chord.push(acc);
+        let d = (x[(i + 1) % n] - x[i]).norm();
+        if d == 0.0 {
+            return Err(CollarError::Coincident(lp.vertices[i], lp.vertices[(i + 1) % n]));
+        }
+        acc += d;
+    }
+    let period = acc;
+    let uniform = |c: usize| {
+        PeriodicSpline::new((0..c).map(|j| period * j as f64 / c as f64).collect(), period)
+            .expect("uniform breakpoints")
+    };
+    let spine_controls = (n / 6).clamp(6, 64);
+    let us = uniform(spine_controls);
+    let controls = 3 * spine_controls;
+    let ub = uniform(controls);
+    // 1. the spine
+    let rows = chord.iter().zip(&x).map(|(&t, &xi)| {
+        let (j0, b) = us.basis(t, 0);
+        ((0..4).map(|r| ((j0 + r) % spine_controls, b[0][r])).collect(), xi)
+    });
+    let (sol_spine, _) = penalised_fit(spine_controls, 1, rows)?;
+    let spine = us.curve(&column(&sol_spine, 0..spine_controls, 1.0));
+    // the vertices within `rings` rings, each with the loop vertex it was reached from
+    let mut origin: Vec<Option<usize>> = vec![None; m.positions.len()];
+    let mut front: Vec<u32> = lp.vertices.clone();
+    let mut pts: Vec<(u32, usize)> = Vec::new();
+    for (k, &v) in lp.vertices.iter().enumerate() {
+        origin[v as usize] = Some(k);
+        pts.push((v, k));
+    }
+    for _ in 1..=rings {
+        let mut next = Vec::new();
+        for &v in &front {
+            let k = origin[v as usize].expect("a front vertex has an origin");
+            for &w in &adj[v as usize] {
+                if origin[w as usize].is_none() {
+                    origin[w as usize] = Some(k);
+                    next.push(w);
+                    pts.push((w, k));
+                }
+            }
+        }
+        front = next;
+    }
+    let needed = 4 * controls;
+    if pts.len() < needed {
+        return Err(CollarError::TooFewPoints { points: pts.len(), rings, needed });
+    }
+    // 2. parameters: feet on the spine and signed distances
+    let on_loop = triangles_on_loop(m, lp);
+    let feet: Vec<(f64, f64, Vec3)> = pts
+        .iter()
+        .map(|&(v, k)| {
+            let xv = m.positions[v as usize];
+            let w = foot(&spine, &chord, period, k, 3 + 2 * rings, xv);
+            let j = spine.jet(&[w], JetShape::new(&[1]));
+            let (pw, t) = (j.derivative([0, 0, 0]), j.derivative([1, 0, 0]));
+            let side = m.face_normal(on_loop[k]).cross(t);
+            let d = xv - pw;
+            let s = if d.dot(side) >= 0.0 { d.norm() } else { -d.norm() };
+            (w, s, d)
+        })
+        .collect();
+    let width = feet.iter().fold(0.0, |a: f64, f| max_nan(a, f.1));
+    if width.partial_cmp(&0.0) != Some(Ordering::Greater) {
+        return Err(CollarError::TooFewPoints { points: 0, rings, needed });
+    }
+    // 3. the surface, in β = s / width for D̃_k = width^k D_k
+    let rows = feet.iter().map(|&(w, s, d)| {
+        let (j0, bas) = ub.basis(w, 0);
+        let beta = s / width;
+        let cols = (0..4)
+            .flat_map(|k| (0..4).map(move |t| (k, t)))
+            .map(|(k, t)| (k * controls + (j0 + t) % controls, beta.powi(k as i32) * bas[0][t]))
+            .collect();
+        (cols, d)
+    });
+    let (sol, cond) = penalised_fit(4 * controls, 4, rows)?;
+    let d: [NurbsCurve; 4] =
+        std::array::from_fn(|k| ub.curve(&column(&sol, k * controls..(k + 1) * controls, width.powi(-(k as i32)))));
+    let collar = Collar { spine, d, period };
+    let mut sq = 0.0;
+    let mut max_residual: f64 = 0.0;
+    for (&(v, _), &(w, s, _)) in pts.iter().zip(&feet) {
+        let e = (m.positions[v as usize] - collar.eval(&[s, w])).norm();
+        sq += e * e;
+        max_residual = max_nan(max_residual, e);
+    }
+    // 4. the loop on it: w_i increasing from w₀ within one period
+    let w0 = feet[0].0;
+    let mut params: Vec<(f64, f64)> = Vec::with_capacity(n);
+    for (i, f) in feet[..n].iter().enumerate() {
+        let w = w0 + (f.0 - w0).rem_euclid(period);
+        if i > 0 && w.partial_cmp(&params[i - 1].1) != Some(Ordering::Greater) {
+            return Err(CollarError::NotMonotone(lp.vertices[i]));
+        }
+        params.push((f.1, w));
+    }
+    let loop_residual =
+        (0..n).fold(0.0, |a: f64, i| max_nan(a, (collar.eval(&[params[i].0, params[i].1]) - x[i]).norm()));
+    check_orientation(m, lp, &collar, &params, period, width, &on_loop)?;
+    Ok(CollarFit {
+        collar,
+        params,
+        period,
+        points: pts.len(),
+        controls,
+        spine_basis: us,
+        width,
+        rms: (sq / feet.len() as f64).sqrt(),
+        max_residual,
+        loop_residual,
+        cond,
+    })
+}
+
+/// The foot of `x` on the spine `p`: the nearest of 16 samples a loop edge within `reach`
+/// loop edges of vertex `k` (chord parameters `chord`), refined by Newton.
+fn foot(p: &NurbsCurve, chord: &[f64], period: f64, k: usize, reach: usize, x: Vec3) -> f64 {
+    let n = chord.len();
+    let at = |i: isize| -> f64 {
+        let kk = i.rem_euclid(n as isize) as usize;
+        chord[kk] + period * (i - kk as isize).div_euclid(n as isize) as f64
+    };
+    let reach = reach.min(n / 2) as isize;
+    let (lo, hi) = (at(k as isize - reach), at(k as isize + reach));
+    let wrap = |w: f64| w.rem_euclid(period);
+    let mut best = (f64::INFINITY, lo);
+    let samples = 16 * reach as usize;
+    for i in 0..=samples {
+        let w = lo + (hi - lo) * i as f64 / samples as f64;
+        let d = (p.eval(&[wrap(w)]) - x).norm();
+        if d < best.0 {
+            best = (d, w);
+        }
+    }
+    let mut w = best.1;
+    let shape = JetShape::new(&[2]);
+    for _ in 0..20 {
+        let j = p.jet(&[wrap(w)], shape);
+        let (c, c1, c2) = (j.derivative([0, 0, 0]), j.derivative([1, 0, 0]), j.derivative([2, 0, 0]));
+        let f = (c - x).dot(c1);
+        let df = c1.dot(c1) + (c - x).dot(c2);
+        if df.partial_cmp(&0.0) != Some(Ordering::Greater) {
+            break;
+        }
+        let step = (f / df).clamp(-(hi - lo) / 8.0, (hi - lo) / 8.0);
+        w = (w - step).clamp(lo, hi);
+        if step.abs() <= 1e-15 * period {
+            break;
+        }
+    }
+    wrap(w)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn check_orientation(
+    m: &TriMesh,
+    lp: &MeshLoop,
+    collar: &Collar,
+    params: &[(f64, f64)],
+    period: f64,
+    width: f64,
+    on_loop: &[usize],
+) -> Result<(), CollarError> {
+    let n = lp.vertices.len();
+    let shape = JetShape::new(&[1, 1]);
+    for i in 0..n {
+        let w1 = if i + 1 == n { params[0].1 + period } else { params[i + 1].1 };
+        let wm = 0.5 * (params[i].1 + w1);
+        let tn = m.face_normal(on_loop[i]);
+        let s0 = 0.5 * (params[i].0 + params[(i + 1) % n].0);
+        for s in [s0, 0.5 * width, width] {
+            let j = collar.jet(&[s, wm], shape);
+            let cn = j.derivative([0, 1, 0]).cross(j.derivative([1, 0, 0]));
+            let cosang = cn.dot(tn) / (cn.norm() * tn.norm());
+            if cosang.partial_cmp(&0.0) != Some(Ordering::Greater) {
+                return Err(CollarError::Folds { vertex: lp.vertices[i], angle: cosang.clamp(-1.0, 1.0).acos() });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// For each loop edge `(v_i, v_{i+1})`, the triangle that runs it.
+pub(super) fn triangles_on_loop(m: &TriMesh, lp: &MeshLoop) -> Vec<usize> {
+    let n = lp.vertices.len();
+    let mut want: std::collections::HashMap<(u32, u32), usize> =
+        (0..n).map(|i| ((lp.vertices[i], lp.vertices[(i + 1) % n]), i)).collect();
+    let mut out = vec![usize::MAX; n];
+    for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
+        for e in [(a, b), (b, c), (c, a)] {
+            if let Some(i) = want.remove(&e) {
+                out[i] = t;
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,371 @@
+//! A mesh's hole filled: the collar fitted ([`super::collar`]), a fill of order 4 (G1) or
+//! 6 (G2) that meets it along the loop, meshed at the density around the hole and stitched
+//! to the loop's own vertices.
+//!
+//! **The fill.** A hole's loop zigzags along the mesh's edges; a fill forced through such
+//! a loop would carry the zigzag into its boundary layer. The fill is therefore bounded by
+//! the collar's isoline `s = s_c`, a smooth curve just inside the hole
+//! (`s_c = min_i s_i − h/2`, `s_i` the loop vertices' own `s`), cut into four pieces of
+//! equal `w`-length; its cross tangent points to `−C_s`, away from the mesh, and it meets
+//! the collar G1 (order 4) or G2 (order 6) along that curve by construction. Its boundary
+//! is `X(0, v) = C(s_c, w₀ + L v / 2π)`.
+//!
+//! **The band.** Between the loop and the fill's boundary lies a band of the collar
+//! itself, at most about one edge wide: the loop's vertices (at `v_i = 2π (w_i − w₀) / L`)
+//! are zipped to the fill boundary's vertices. The mesh's loop vertices lie on the
+//! collar up to its fit residual (reported), the fill's vertices on the fill.
+//!
+//! **The mesh.** `h`, the median length of the mesh's edges at the loop's vertices, sets
+//! the density: the fill's boundary gets `round(length / h)` vertices, then rings
+//! `u = u_j` at equal steps of the mean arc length from the boundary to the pole,
+//! `round(ℓ / h)` of them, each with `round(perimeter / h)` vertices (at least 3) at
+//! equal steps of `v`, staggered from ring to ring, and the pole. Neighbouring rings are
+//! zipped by increasing `v` (the next triangle takes whichever ring's next vertex comes
+//! first). Every triangle is clockwise in the `(v, u)` chart, which makes it run each loop
+//! edge against the way the mesh runs it: the output is consistently oriented, and each
+//! loop edge ends up in exactly two triangles.
+
+use super::collar::{CollarError, CollarFit, DomainLine, adjacency, fit_collar, triangles_on_loop};
+use super::{LoopKind, MeshLoop, TriMesh};
+use crate::Vec3;
+use crate::data::FieldRef;
+use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, Fill, FillEdge, FillError, FillOptions, Host};
+use crate::num::max_nan;
+use crate::patch::Surface;
+use faer::linalg::solvers::Solve;
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// How a loop is filled.
+#[derive(Clone, Debug)]
+pub struct LoopFillOptions {
+    /// 4 (G1) or 6 (G2).
+    pub order: usize,
+    /// Rings of vertices around the loop that the collar is fitted to.
+    pub rings: usize,
+}
+
+impl Default for LoopFillOptions {
+    fn default() -> Self {
+        LoopFillOptions { order: 4, rings: 3 }
+    }
+}
+
+/// A filled loop: the new vertices and triangles, and what was measured.
+pub struct LoopFill {
+    /// The collar and its fit.
+    pub fit: CollarFit,
+    /// The fill.
+    pub fill: Fill,
+    /// New vertices, to be appended to the mesh's (their indices start at the `base`
+    /// given to [`fill_loop`]).
+    pub positions: Vec<Vec3>,
+    /// New triangles, on the loop's vertices and the new ones.
+    pub triangles: Vec<[u32; 3]>,
+    /// The fill against the collar along the loop, at 64 points a piece.
+    pub continuity: EdgeContinuity,
+    /// The largest angle (radians) between a loop edge's mesh triangle and its fill
+    /// triangle.
+    pub seam_dihedral: f64,
+    /// `h`: the median edge length at the loop's vertices.
+    pub edge_length: f64,
+    /// The shortest and longest new edge divided by `h`.
+    pub edge_ratio: (f64, f64),
+}
+
+/// Why a loop is not filled.
+#[derive(Debug, thiserror::Error)]
+pub enum LoopFillError {
+    /// Not a simple loop.
+    #[error("the loop passes a vertex twice: not a simple hole")]
+    NotSimple,
+    /// The loop has fewer than 3 vertices.
+    #[error("the loop has {0} vertices")]
+    TooShort(usize),
+    /// The collar.
+    #[error(transparent)]
+    Collar(#[from] CollarError),
+    /// The fill.
+    #[error(transparent)]
+    Fill(#[from] FillError),
+    /// The fill turns over.
+    #[error("the fill folds ({0} points of a 32 × 64 grid turn over)")]
+    Folds(usize),
+    /// The fill found a crease in the collar or dropped a piece.
+    #[error("the collar has a crease or a piece without length")]
+    Crease,
+}
+
+/// Fills loop `lp` of `m`; the new vertices are numbered from `base`.
+pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> Result<LoopFill, LoopFillError> {
+    if lp.kind != LoopKind::Simple {
+        return Err(LoopFillError::NotSimple);
+    }
+    let n = lp.vertices.len();
+    if n < 3 {
+        return Err(LoopFillError::TooShort(n));
+    }
+    let original = (m, lp);
+    let h = median_edge(m, &adjacency(m), lp);
+    // the loop's sharp notches closed first, by triangles on its own vertices
+    let (ears, clipped) = clip_ears(m, lp, h);
+    let with_ears;
+    let (m, lp) = if ears.is_empty() {
+        (m, lp)
+    } else {
+        let mut w = m.clone();
+        w.triangles.extend(&ears);
+        with_ears = (w, MeshLoop { vertices: clipped, ..lp.clone() });
+        (&with_ears.0, &with_ears.1)
+    };
+    let adj = adjacency(m);
+    let fit = fit_collar(m, &adj, lp, o.rings)?;
+    let (period, w0) = (fit.period, fit.params[0].1);
+    let line = boundary_line(&fit, h);
+    let along = AlongCurve {
+        host: Host::Field(Arc::new(fit.collar.clone())),
+        curve: DomainCurve::Field(Arc::new(line.clone())),
+    };
+    let surface: FieldRef = Arc::new(along);
+    // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
+    let edges: Vec<FillEdge> = (0..4)
+        .map(|k| FillEdge {
+            surface: surface.clone(),
+            s0: 0.0,
+            w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
+            fullness: 1.0,
+            side: Some(1.0),
+        })
+        .collect();
+    let fill = Fill::new(&edges, &FillOptions { order: o.order, ..FillOptions::default() })?;
+    if !fill.report().dropped_edges.is_empty() || !fill.report().split_edges.is_empty() {
+        return Err(LoopFillError::Crease);
+    }
+    let folds = fill.folds(32, 64);
+    if folds > 0 {
+        return Err(LoopFillError::Folds(folds));
+    }
+    let continuity = fill.edge_continuity(64);
+    let patch = fill.patch().clone();
+    // arc length from the loop to the pole, averaged over v
+    let (nsu, nsv) = (129, 32);
+    let us: Vec<f64> = (0..nsu).map(|i| i as f64 / (nsu - 1) as f64).collect();
+    let vs: Vec<f64> = (0..nsv).map(|j| TAU * j as f64 / nsv as f64).collect();
+    let mut arc = vec![0.0; nsu];
+    for &v in &vs {
+        let mut prev = patch.point(0.0, v);
+        for i in 1..nsu {
+            let p = patch.point(us[i], v);
+            arc[i] += (p - prev).norm() / nsv as f64;
+            prev = p;
+        }
+    }
+    for i in 1..nsu {
+        arc[i] += arc[i - 1];
+    }
+    let total = arc[nsu - 1];
+    let rings = ((total / h).round() as usize).max(1);
+    let u_at = |target: f64| -> f64 {
+        let i = arc.partition_point(|&a| a < target).clamp(1, nsu - 1);
+        let (a0, a1) = (arc[i - 1], arc[i]);
+        let t = if a1 > a0 { (target - a0) / (a1 - a0) } else { 0.0 };
+        us[i - 1] + t * (us[i] - us[i - 1])
+    };
+    let mut positions = Vec::new();
+    // chart heights: −s in the band (scaled like v), then the fill's u above it
+    let y_of_s = |s: f64| -TAU * s / period;
+    let s_top = fit.params.iter().fold(f64::INFINITY, |a, p| a.min(p.0)) - 2.0 * h;
+    let lp_ring: Vec<(f64, f64, u32)> =
+        fit.params.iter().zip(&lp.vertices).map(|(&(s, w), &v)| (TAU * (w - w0) / period, y_of_s(s), v)).collect();
+    let mut triangles = ears;
+    let mut ring_prev = Vec::new();
+    for j in 0..rings {
+        let u = if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) };
+        let perim: f64 = (0..64)
+            .map(|k| (patch.point(u, TAU * (k + 1) as f64 / 64.0) - patch.point(u, TAU * k as f64 / 64.0)).norm())
+            .sum();
+        let nj = ((perim / h).round() as usize).max(3);
+        let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
+        // the fill's boundary gets the loop's own v: the band is a strip of quads
+        let ring_v: Vec<f64> = if j == 0 {
+            let nl = lp_ring.len();
+            (0..nl).map(|i| 0.5 * (lp_ring[i].0 + if i + 1 < nl { lp_ring[i + 1].0 } else { TAU })).collect()
+        } else {
+            (0..nj).map(|k| TAU * (k as f64 + shift) / nj as f64).collect()
+        };
+        let ring: Vec<(f64, f64, u32)> = ring_v
+            .into_iter()
+            .map(|v| {
+                positions.push(patch.point(u, v));
+                let y = if j == 0 { y_of_s(line.sigma(w0 + period * v / TAU)) } else { y_of_s(s_top) + u };
+                (v, y, base + positions.len() as u32 - 1)
+            })
+            .collect();
+        let at = |i: u32| {
+            if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
+        };
+        zip(if j == 0 { &lp_ring } else { &ring_prev }, &ring, &at, &mut triangles);
+        ring_prev = ring;
+    }
+    positions.push(patch.point(1.0, 0.0));
+    let pole = base + positions.len() as u32 - 1;
+    let np = ring_prev.len();
+    for i in 0..np {
+        triangles.push([ring_prev[(i + 1) % np].2, ring_prev[i].2, pole]);
+    }
+    // measures: the seam's dihedral angles and the new edges' lengths
+    let at = |i: u32| {
+        if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
+    };
+    let normal = |t: &[u32; 3]| (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
+    let (m, lp) = (original.0, original.1);
+    let n = lp.vertices.len();
+    let on_loop = triangles_on_loop(m, lp);
+    let mut seam_dihedral: f64 = 0.0;
+    let mut edge_ratio = (f64::INFINITY, 0.0f64);
+    let mut fill_of = std::collections::HashMap::new();
+    for t in &triangles {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            fill_of.insert((a, b), *t);
+            let r = (at(a) - at(b)).norm() / h;
+            edge_ratio = (edge_ratio.0.min(r), max_nan(edge_ratio.1, r));
+        }
+    }
+    for (i, &tri) in on_loop.iter().enumerate() {
+        let (a, b) = (lp.vertices[i], lp.vertices[(i + 1) % n]);
+        let Some(ft) = fill_of.get(&(b, a)) else {
+            return Err(LoopFillError::Crease);
+        };
+        let (n1, n2) = (m.face_normal(tri), normal(ft));
+        let ang = n1.cross(n2).norm().atan2(n1.dot(n2));
+        seam_dihedral = max_nan(seam_dihedral, ang);
+    }
+    Ok(LoopFill { fit, fill, positions, triangles, continuity, seam_dihedral, edge_length: h, edge_ratio })
+}
+
+/// The fill's boundary in the collar's domain: `σ̄`, a spline on the spine's breakpoints
+/// fitted to `s_i − 0.87 h` at the loop's vertices (the height of an equilateral triangle
+/// on a loop edge), lowered where it comes within `0.4 h` of a vertex's `s_i`.
+fn boundary_line(fit: &CollarFit, h: f64) -> DomainLine {
+    let b = &fit.spine_basis;
+    let nc = b.len();
+    let mut g = faer::Mat::<f64>::zeros(nc, nc);
+    let mut r = faer::Mat::<f64>::zeros(nc, 1);
+    for &(s, w) in &fit.params {
+        let (j0, bas) = b.basis(w, 0);
+        for p in 0..4 {
+            r[((j0 + p) % nc, 0)] += bas[0][p] * (s - 0.87 * h);
+            for q in 0..4 {
+                g[((j0 + p) % nc, (j0 + q) % nc)] += bas[0][p] * bas[0][q];
+            }
+        }
+    }
+    for i in 0..nc {
+        g[(i, i)] += 1e-9;
+    }
+    let sol = g.full_piv_lu().solve(&r);
+    let mut ctrl: Vec<f64> = (0..nc).map(|i| sol[(i, 0)]).collect();
+    let line = DomainLine::new(b, &ctrl);
+    let over = fit.params.iter().fold(f64::NEG_INFINITY, |a, &(s, w)| a.max(line.sigma(w) - (s - 0.4 * h)));
+    if over > 0.0 {
+        // a spline's values shift with its control points (partition of unity)
+        ctrl.iter_mut().for_each(|c| *c -= over);
+    }
+    DomainLine::new(b, &ctrl)
+}
+
+/// Closes the loop's sharp notches: a vertex where the loop turns towards the hole by an
+/// interior angle below 100° and whose two neighbours lie within 1.5 `h` of each other gets
+/// the triangle on its two edges (the loop then runs straight from one neighbour to the
+/// other); never two neighbouring vertices in one pass, two passes, at least four vertices
+/// left. Returns the triangles and the loop that remains.
+fn clip_ears(m: &TriMesh, lp: &MeshLoop, h: f64) -> (Vec<[u32; 3]>, Vec<u32>) {
+    let on_loop = triangles_on_loop(m, lp);
+    let mut verts: Vec<(u32, Vec3)> = lp
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let prev = on_loop[(i + lp.vertices.len() - 1) % lp.vertices.len()];
+            let nrm = m.face_normal(on_loop[i]).normalized().unwrap_or(Vec3::ZERO)
+                + m.face_normal(prev).normalized().unwrap_or(Vec3::ZERO);
+            (v, nrm)
+        })
+        .collect();
+    let adj = adjacency(m);
+    let mut ears = Vec::new();
+    for _ in 0..2 {
+        let n = verts.len();
+        let mut clip = vec![false; n];
+        for i in 0..n {
+            if n - clip.iter().filter(|c| **c).count() <= 4 || clip[(i + n - 1) % n] {
+                continue;
+            }
+            let (a, b, c) = (verts[(i + n - 1) % n].0, verts[i].0, verts[(i + 1) % n].0);
+            let [pa, pb, pc] = [a, b, c].map(|v| m.positions[v as usize]);
+            let (e1, e2) = (pa - pb, pc - pb);
+            let right_turn = (pb - pa).cross(pc - pb).dot(verts[i].1) < 0.0;
+            let angle = e1.cross(e2).norm().atan2(e1.dot(e2));
+            let known = adj[a as usize].binary_search(&c).is_ok();
+            if right_turn && angle < 100f64.to_radians() && (pc - pa).norm() <= 1.5 * h && !known && i + 1 < n {
+                clip[i] = true;
+                ears.push([c, b, a]);
+            }
+        }
+        if !clip.contains(&true) {
+            break;
+        }
+        verts = verts.into_iter().zip(&clip).filter(|(_, c)| !**c).map(|(v, _)| v).collect();
+    }
+    (ears, verts.into_iter().map(|v| v.0).collect())
+}
+
+/// The median length of the mesh's edges at the loop's vertices.
+fn median_edge(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop) -> f64 {
+    let mut lens: Vec<f64> = lp
+        .vertices
+        .iter()
+        .flat_map(|&v| adj[v as usize].iter().map(move |&w| (v, w)))
+        .map(|(v, w)| (m.positions[v as usize] - m.positions[w as usize]).norm())
+        .collect();
+    lens.sort_by(f64::total_cmp);
+    lens[lens.len() / 2]
+}
+
+/// Triangulates the band between rings `a` and `b`, each `(v, y, vertex)` with `v`
+/// increasing in `[0, 2π)` and `y` the height in a chart where `b` lies above `a`. Each
+/// step adds the triangle that advances along `a` or along `b`: the one whose next vertex
+/// comes first in `v` (the shorter new edge in space when the two are close), unless that
+/// triangle is not clockwise in the chart `(v, y)` (it would turn over) and the other is.
+fn zip(a: &[(f64, f64, u32)], b: &[(f64, f64, u32)], pos: &dyn Fn(u32) -> Vec3, out: &mut Vec<[u32; 3]>) {
+    // the v-order step, unless its triangle turns over in the chart and the other does not
+    let (na, nb) = (a.len(), b.len());
+    let pa = |i: usize| if i < na { (a[i].0, a[i].1) } else { (a[i - na].0 + TAU, a[i - na].1) };
+    let pb = |k: usize| if k < nb { (b[k].0, b[k].1) } else { (b[k - nb].0 + TAU, b[k - nb].1) };
+    let cw = |p: (f64, f64), q: (f64, f64), r: (f64, f64)| (q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0) < 0.0;
+    let (mut i, mut k) = (0, 0);
+    while i < na || k < nb {
+        let ok_a = i < na && cw(pa(i + 1), pa(i), pb(k));
+        let ok_b = k < nb && cw(pa(i), pb(k), pb(k + 1));
+        let by_v = k == nb || (i < na && pa(i + 1).0 <= pb(k + 1).0);
+        let advance_a = match (ok_a, ok_b) {
+            (true, true) => {
+                // near a tie in v, the shorter new edge
+                let da = (pos(a[(i + 1) % na].2) - pos(b[k % nb].2)).norm();
+                let db = (pos(a[i % na].2) - pos(b[(k + 1) % nb].2)).norm();
+                let (ga, gb) = (pa(i + 1).0 - pb(k).0, pb(k + 1).0 - pa(i).0);
+                if (ga - gb).abs() < 0.25 * (ga + gb).abs() { da <= db } else { by_v }
+            }
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) => by_v,
+        };
+        if advance_a {
+            out.push([a[(i + 1) % na].2, a[i % na].2, b[k % nb].2]);
+            i += 1;
+        } else {
+            out.push([a[i % na].2, b[k % nb].2, b[(k + 1) % nb].2]);
+            k += 1;
+        }
+    }
+}

@@ -1,0 +1,223 @@
+//! A mesh's topology checked, and its boundary edges chained into loops.
+//!
+//! In an oriented 2-manifold with boundary each interior edge is run once in each
+//! direction by its two triangles and each boundary edge once by its one triangle. The
+//! boundary half-edges then follow each other head to tail around every hole, the mesh on
+//! their left: a loop is a cycle of them, run the way the mesh runs them. A vertex where
+//! more than one boundary half-edge leaves (two holes meeting at a point, or a loop that
+//! pinches) makes its loops [`LoopKind::TouchesItself`].
+
+use super::TriMesh;
+use crate::Vec3;
+use std::collections::HashMap;
+
+/// What makes a mesh unusable, with the element's index.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TopologyError {
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex}: a coordinate is not finite")]
+    NonFinite {
+        /// The vertex (from 0).
+        vertex: usize,
+    },
+    /// A triangle names a vertex that does not exist.
+    #[error("triangle {triangle}: vertex index {index} is out of range (the mesh has {count} vertices)")]
+    IndexOutOfRange {
+        /// The triangle (from 0).
+        triangle: usize,
+        /// The index.
+        index: u32,
+        /// The vertex count.
+        count: usize,
+    },
+    /// A triangle repeats a vertex or has no area.
+    #[error("triangle {triangle} is degenerate ({why})")]
+    Degenerate {
+        /// The triangle (from 0).
+        triangle: usize,
+        /// `a repeated vertex` or `zero area`.
+        why: &'static str,
+    },
+    /// Two triangles on the same three vertices.
+    #[error("triangle {triangle} repeats triangle {first} (the same three vertices)")]
+    Duplicate {
+        /// The later triangle.
+        triangle: usize,
+        /// The earlier one.
+        first: usize,
+    },
+    /// An edge of more than two triangles.
+    #[error("edge ({a}, {b}) is non-manifold: triangles {triangles:?} share it")]
+    NonManifold {
+        /// Its vertices.
+        a: u32,
+        /// Its vertices.
+        b: u32,
+        /// The triangles that share it.
+        triangles: Vec<usize>,
+    },
+    /// Two triangles run an edge the same way: the mesh is not consistently oriented.
+    #[error(
+        "edge ({a}, {b}) is run the same way by triangles {first} and {second}: the mesh is not consistently oriented"
+    )]
+    Orientation {
+        /// The edge's tail.
+        a: u32,
+        /// Its head.
+        b: u32,
+        /// The first triangle.
+        first: usize,
+        /// The second.
+        second: usize,
+    },
+}
+
+/// What a boundary loop is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoopKind {
+    /// A simple closed loop: a hole (or the rim of an open surface: the mesh does not tell
+    /// them apart; `--max-edges` leaves big loops open).
+    Simple,
+    /// The loop passes a vertex where more than one boundary edge leaves.
+    TouchesItself,
+}
+
+/// A loop of boundary edges.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshLoop {
+    /// Its vertices, in the direction the mesh runs its edges (the mesh on the left).
+    pub vertices: Vec<u32>,
+    /// What it is.
+    pub kind: LoopKind,
+    /// Its length.
+    pub length: f64,
+    /// Its bounding box.
+    pub bbox: (Vec3, Vec3),
+}
+
+/// Checks that `m` is an oriented 2-manifold with boundary and returns its boundary loops
+/// (longest first is not implied: in the order their first half-edges appear).
+pub fn boundary(m: &TriMesh) -> Result<Vec<MeshLoop>, TopologyError> {
+    let nv = m.positions.len();
+    if let Some(vertex) = m.positions.iter().position(|p| !p.is_finite()) {
+        return Err(TopologyError::NonFinite { vertex });
+    }
+    let mut half: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * m.triangles.len());
+    let mut sets: HashMap<[u32; 3], usize> = HashMap::with_capacity(m.triangles.len());
+    for (t, tri) in m.triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= nv) {
+            return Err(TopologyError::IndexOutOfRange { triangle: t, index, count: nv });
+        }
+        let [a, b, c] = *tri;
+        if a == b || b == c || a == c {
+            return Err(TopologyError::Degenerate { triangle: t, why: "a repeated vertex" });
+        }
+        if m.face_normal(t) == Vec3::ZERO {
+            return Err(TopologyError::Degenerate { triangle: t, why: "zero area" });
+        }
+        let mut key = *tri;
+        key.sort_unstable();
+        if let Some(&first) = sets.get(&key) {
+            return Err(TopologyError::Duplicate { triangle: t, first });
+        }
+        sets.insert(key, t);
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            if let Some(&first) = half.get(&(x, y)) {
+                // a third triangle on an edge run both ways already is non-manifold
+                if let Some(&other) = half.get(&(y, x)) {
+                    return Err(TopologyError::NonManifold {
+                        a: x.min(y),
+                        b: x.max(y),
+                        triangles: vec![first, other, t],
+                    });
+                }
+                return Err(TopologyError::Orientation { a: x, b: y, first, second: t });
+            }
+            half.insert((x, y), t);
+        }
+    }
+    // more than two triangles on one undirected edge shows as both directions taken and a
+    // third use; caught above. Boundary half-edges: those whose twin is missing.
+    let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &(x, y) in half.keys() {
+        if !half.contains_key(&(y, x)) {
+            out.entry(x).or_default().push(y);
+        }
+    }
+    for v in out.values_mut() {
+        v.sort_unstable();
+    }
+    let mut starts: Vec<(usize, u32, u32)> = Vec::new();
+    for (t, tri) in m.triangles.iter().enumerate() {
+        let [a, b, c] = *tri;
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            if !half.contains_key(&(y, x)) {
+                starts.push((t, x, y));
+            }
+        }
+    }
+    let mut used: HashMap<(u32, u32), bool> = HashMap::new();
+    let mut loops = Vec::new();
+    for &(_, x0, y0) in &starts {
+        if used.contains_key(&(x0, y0)) {
+            continue;
+        }
+        let mut vertices = vec![x0];
+        let mut pinched = out[&x0].len() > 1;
+        let (mut x, mut y) = (x0, y0);
+        loop {
+            used.insert((x, y), true);
+            if y == x0 {
+                break;
+            }
+            vertices.push(y);
+            let next = &out[&y];
+            pinched |= next.len() > 1;
+            // the first unused boundary half-edge leaving y (every vertex of a boundary
+            // half-edge's head has one leaving it: the mesh's edges are paired)
+            let Some(&z) = next.iter().find(|&&z| !used.contains_key(&(y, z))) else { break };
+            (x, y) = (y, z);
+        }
+        let pts: Vec<Vec3> = vertices.iter().map(|&i| m.positions[i as usize]).collect();
+        let length = (0..pts.len()).map(|i| (pts[(i + 1) % pts.len()] - pts[i]).norm()).sum();
+        let bbox = pts.iter().fold((pts[0], pts[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let kind = if pinched { LoopKind::TouchesItself } else { LoopKind::Simple };
+        loops.push(MeshLoop { vertices, kind, length, bbox });
+    }
+    Ok(loops)
+}
+
+/// The angle (radians) between the normals of the two triangles of every interior edge,
+/// with the edge, NaN where a triangle has no normal.
+pub fn dihedral_angles(m: &TriMesh) -> Vec<((u32, u32), f64)> {
+    let mut half: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * m.triangles.len());
+    for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
+        for e in [(a, b), (b, c), (c, a)] {
+            half.insert(e, t);
+        }
+    }
+    let mut out = Vec::new();
+    for (&(x, y), &t) in &half {
+        if x < y
+            && let Some(&s) = half.get(&(y, x))
+        {
+            let (n1, n2) = (m.face_normal(t), m.face_normal(s));
+            let c = n1.dot(n2) / (n1.norm() * n2.norm());
+            let sn = n1.cross(n2).norm() / (n1.norm() * n2.norm());
+            out.push(((x, y), sn.atan2(c)));
+        }
+    }
+    out.sort_by_key(|e| e.0);
+    out
+}
+
+/// The `q`-quantile (0 ≤ q ≤ 1) of `values` by the nearest rank, NaN if any value is NaN.
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    if values.iter().any(|v| v.is_nan()) || values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let k = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+    v[k]
+}

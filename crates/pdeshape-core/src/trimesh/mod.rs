@@ -1,0 +1,43 @@
+//! Triangle meshes from outside (scans, printed parts): their holes found and filled.
+//!
+//! A [`TriMesh`] is what a mesh file holds: shared vertices and triangles. [`boundary`]
+//! checks that it is an oriented 2-manifold with boundary (every edge in one or two
+//! triangles, run in opposite directions by two) and chains its boundary edges into loops
+//! ([`MeshLoop`]). [`fill_loop`] fills a simple loop by a fill of order 4 (G1) or 6 (G2):
+//! the surface around the loop is estimated by a [`Collar`] fitted to the vertices within
+//! a few rings of it, the fill meets the collar G1/G2 along the loop, and the fill is
+//! meshed at the density of the mesh around it and stitched to the loop's own vertices.
+
+mod collar;
+mod fill;
+mod loops;
+mod periodic;
+pub mod shapes;
+
+pub use collar::{Collar, CollarError, CollarFit, adjacency, fit_collar};
+pub use fill::{LoopFill, LoopFillError, LoopFillOptions, fill_loop};
+pub use loops::{LoopKind, MeshLoop, TopologyError, boundary, dihedral_angles, quantile};
+pub use periodic::PeriodicSpline;
+
+use crate::Vec3;
+
+/// A triangle mesh: vertex positions and triangles of vertex indices, counter-clockwise
+/// about their outward side.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// The unnormalised normal `(b − a) × (c − a)` of triangle `t`.
+    pub fn face_normal(&self, t: usize) -> Vec3 {
+        let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);
+        (b - a).cross(c - a)
+    }
+}
+
+#[cfg(test)]
+mod tests;
