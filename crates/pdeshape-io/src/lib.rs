@@ -9,6 +9,7 @@ pub mod cad;
 pub mod export;
 pub mod holes;
 pub mod import;
+pub mod mesh_holes;
 pub mod model;
 pub mod render;
 pub mod sample;

@@ -103,22 +103,24 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = setting)]
         set: Vec<(String, f64)>,
     },
-    /// List the holes of a model (STEP): the loops of its free boundary, with their
-    /// edges, the faces around, length, bounding box and whether the faces meet G1 at
-    /// each corner.
+    /// List the holes of a model: a STEP model's loops of free edges (with the faces
+    /// around and whether they meet G1 at each corner) or a triangle mesh's boundary loops
+    /// (OBJ, PLY, STL), with length and bounding box.
     Holes {
-        /// The model (.step or .stp).
+        /// The model (.step, .stp, .obj, .ply or .stl).
         model: PathBuf,
         /// Print JSON.
         #[arg(long)]
         json: bool,
     },
-    /// Fill the holes of a model (STEP) with fills of order 4 (G1) or 6 (G2) and write the
-    /// model back with the new faces sewn in (every input face unchanged).
+    /// Fill the holes of a model with fills of order 4 (G1) or 6 (G2) and write it back
+    /// with the fills sewn in: a STEP model with new faces (every input face unchanged), a
+    /// triangle mesh with new triangles stitched to each hole's own vertices (every input
+    /// vertex and triangle kept).
     FillHoles {
-        /// The model (.step or .stp).
+        /// The model (.step, .stp, .obj, .ply or .stl).
         model: PathBuf,
-        /// The output model (.step or .stp).
+        /// The output (.step or .stp for a STEP model; .obj, .ply or .stl for a mesh).
         #[arg(short, long)]
         out: PathBuf,
         /// 4: G1 to the faces around (faces of degree 3); 6: G2 (degree 5).

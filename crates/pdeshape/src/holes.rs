@@ -5,8 +5,11 @@ use crate::usage::Usage;
 use anyhow::{Result, anyhow};
 use pdeshape_core::brep::holes;
 use pdeshape_core::limits::Limits;
+use pdeshape_core::trimesh::{MeshLoop, boundary};
 use pdeshape_io::holes::{FillHolesOptions, fill_holes, holes_report, write_filled};
+use pdeshape_io::import::mesh::{MeshFile, MeshFormat, read_mesh};
 use pdeshape_io::import::step::{StepModel, read_step};
+use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, write_trimesh};
 use std::path::Path;
 
 fn is_step(p: &Path) -> bool {
@@ -16,18 +19,29 @@ fn is_step(p: &Path) -> bool {
 }
 
 fn load(path: &Path, limits: &Limits) -> Result<StepModel> {
-    if !is_step(path) {
-        return Err(Usage(format!(
-            "{}: the model must be a STEP file (.step or .stp); holes of triangle meshes are not read yet",
+    Ok(read_step(path, limits)?)
+}
+
+/// The kind of a model file, from its extension.
+fn kind(path: &Path) -> Result<Option<MeshFormat>> {
+    if is_step(path) {
+        return Ok(None);
+    }
+    match MeshFormat::from_path(path) {
+        Some(f) => Ok(Some(f)),
+        None => Err(Usage(format!(
+            "{}: the model must be a STEP file (.step, .stp) or a triangle mesh (.obj, .ply, .stl)",
             path.display()
         ))
-        .into());
+        .into()),
     }
-    Ok(read_step(path, limits)?)
 }
 
 /// `pdeshape holes MODEL [--json]`.
 pub fn list(path: &Path, json: bool, limits: &Limits) -> Result<()> {
+    if kind(path)?.is_some() {
+        return list_mesh(path, json, limits);
+    }
     let m = load(path, limits)?;
     let hs = holes(&m.brep);
     let r = holes_report(&m, &hs);
@@ -74,6 +88,9 @@ pub fn list(path: &Path, json: bool, limits: &Limits) -> Result<()> {
 
 /// `pdeshape fill-holes MODEL -o OUT [--order 4|6] [--holes I,J | --max-edges N]`.
 pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quiet: bool) -> Result<()> {
+    if kind(path)?.is_some() {
+        return fill_mesh(path, out, o, limits, quiet);
+    }
     if !is_step(out) {
         return Err(Usage(format!("{}: the output must be a STEP file (.step or .stp)", out.display())).into());
     }
@@ -100,6 +117,89 @@ pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quie
             eprintln!(
                 "hole {}: order {}, {} × {} control points, measured deviation {:.3e}; seam gap {:.3e}, G1 {:.3e} rad{g2} ({} points)",
                 f.index, o.order, f.fit.points.0, f.fit.points.1, f.fit.max_deviation, s.gap, s.angle, s.samples
+            );
+        }
+        eprintln!("wrote {}", out.display());
+    }
+    Ok(())
+}
+
+fn read_checked(path: &Path, limits: &Limits) -> Result<(MeshFile, Vec<MeshLoop>)> {
+    let mf = read_mesh(path, limits)?;
+    let loops = boundary(&mf.mesh).map_err(|e| anyhow!("{}: {e}", mf.file))?;
+    Ok((mf, loops))
+}
+
+/// `holes` on a triangle mesh.
+fn list_mesh(path: &Path, json: bool, limits: &Limits) -> Result<()> {
+    let (mf, loops) = read_checked(path, limits)?;
+    let r = mesh_holes_report(&mf, &loops);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {} mesh, {} vertices, {} triangles{}; dihedral angles' 99th percentile {:.3e} rad; {} boundary loop(s)",
+        r.file,
+        r.format,
+        r.vertices,
+        r.triangles,
+        if r.polygons_split > 0 { format!(" ({} polygons split)", r.polygons_split) } else { String::new() },
+        r.dihedral_p99,
+        r.holes.len()
+    );
+    for h in &r.holes {
+        println!(
+            "hole {}: {}, {} edges from vertex {}, length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
+            h.index,
+            h.kind,
+            h.edges,
+            h.first_vertex,
+            h.length,
+            h.bbox[0][0],
+            h.bbox[0][1],
+            h.bbox[0][2],
+            h.bbox[1][0],
+            h.bbox[1][1],
+            h.bbox[1][2]
+        );
+    }
+    Ok(())
+}
+
+/// `fill-holes` on a triangle mesh.
+fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quiet: bool) -> Result<()> {
+    if MeshFormat::from_path(out).is_none() {
+        return Err(Usage(format!("{}: the output of a mesh must be .obj, .ply or .stl", out.display())).into());
+    }
+    let (mf, loops) = read_checked(path, limits)?;
+    let (filled, reports) = fill_mesh_holes(&mf, &loops, o).map_err(|e| anyhow!("{}: {e}", mf.file))?;
+    if reports.is_empty() {
+        return Err(anyhow!("{}: no hole to fill (`pdeshape holes` lists the loops)", mf.file));
+    }
+    write_trimesh(out, &filled).map_err(|e| anyhow!(e))?;
+    if !quiet {
+        let r = mesh_holes_report(&mf, &loops);
+        for h in r.holes.iter().filter(|h| !reports.iter().any(|f| f.index == h.index)) {
+            eprintln!("hole {}: left open ({}, {} edges)", h.index, h.kind, h.edges);
+        }
+        for f in &reports {
+            let g2 = if o.order == 6 { format!(", curvature gap {:.3e}", f.g2) } else { String::new() };
+            eprintln!(
+                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
+                f.index,
+                o.order,
+                f.new_vertices,
+                f.new_triangles,
+                f.collar_rms,
+                f.collar_max,
+                f.collar_points,
+                f.g1,
+                f.gap,
+                f.seam_dihedral,
+                r.dihedral_p99,
+                f.edge_ratio.0,
+                f.edge_ratio.1
             );
         }
         eprintln!("wrote {}", out.display());

@@ -193,8 +193,9 @@ fn bad_models_are_refused_with_the_entity_and_line() {
     // caps
     let cyl = s(&model("cylinder-open.step"));
     refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);
-    // usage: not a STEP file, a missing hole, an output that is not STEP: nothing written
-    refused(&["holes", "model.obj"], 2, &["STEP"]);
+    // usage: neither STEP nor a mesh, a missing hole, an output that is not STEP: nothing
+    // written
+    refused(&["holes", "model.iges"], 2, &["STEP file (.step, .stp) or a triangle mesh"]);
     refused(&["fill-holes", &cyl, "-o", o, "--holes", "2"], 1, &["hole 2 does not exist"]);
     refused(&["fill-holes", &cyl, "-o", &s(&d.join("x.obj"))], 2, &["output must be a STEP"]);
     refused(&["fill-holes", &cyl, "-o", o, "--order", "5"], 2, &["4 (G1) or 6 (G2)"]);

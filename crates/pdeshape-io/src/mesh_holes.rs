@@ -1,0 +1,173 @@
+//! The holes of a triangle mesh: listed (a typed report for `holes` and its JSON), and
+//! filled — each simple loop by [`pdeshape_core::trimesh::fill_loop`] — with the new
+//! vertices and triangles appended to the mesh (every input vertex and triangle kept, in
+//! its place) and written in the format the output's extension names.
+
+use crate::export::{Format, write_meshes};
+use crate::holes::FillHolesOptions;
+use crate::import::mesh::MeshFile;
+use pdeshape_core::mesh::Mesh;
+use pdeshape_core::num::max_nan;
+use pdeshape_core::trimesh::{LoopFillOptions, LoopKind, MeshLoop, TriMesh, dihedral_angles, fill_loop, quantile};
+use serde::Serialize;
+use std::path::Path;
+
+/// What `holes` reports for a mesh.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshHolesReport {
+    /// The file.
+    pub file: String,
+    /// `OBJ`, `PLY` or `STL`.
+    pub format: &'static str,
+    /// Vertices (those used by a triangle and not).
+    pub vertices: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Polygons of more than three vertices split into triangles on reading.
+    pub polygons_split: usize,
+    /// The 99th percentile of the mesh's own dihedral angles (radians), against which a
+    /// fill's seam is judged.
+    pub dihedral_p99: f64,
+    /// The boundary loops, numbered from 1.
+    pub holes: Vec<MeshHoleReport>,
+}
+
+/// One boundary loop.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshHoleReport {
+    /// Its number (from 1), as `--holes` takes it.
+    pub index: usize,
+    /// `hole` or `touches itself`.
+    pub kind: &'static str,
+    /// Its number of edges.
+    pub edges: usize,
+    /// Its first vertex (from 0), where it starts.
+    pub first_vertex: u32,
+    /// Its length.
+    pub length: f64,
+    /// Its bounding box `[min, max]`.
+    pub bbox: [[f64; 3]; 2],
+}
+
+/// The report of a mesh's loops (`loops` from [`pdeshape_core::trimesh::boundary`]).
+pub fn mesh_holes_report(mf: &MeshFile, loops: &[MeshLoop]) -> MeshHolesReport {
+    let angles: Vec<f64> = dihedral_angles(&mf.mesh).into_iter().map(|e| e.1).collect();
+    MeshHolesReport {
+        file: mf.file.clone(),
+        format: mf.format.name(),
+        vertices: mf.mesh.positions.len(),
+        triangles: mf.mesh.triangles.len(),
+        polygons_split: mf.polygons_split,
+        dihedral_p99: quantile(&angles, 0.99),
+        holes: loops
+            .iter()
+            .enumerate()
+            .map(|(i, l)| MeshHoleReport {
+                index: i + 1,
+                kind: match l.kind {
+                    LoopKind::Simple => "hole",
+                    LoopKind::TouchesItself => "touches itself",
+                },
+                edges: l.vertices.len(),
+                first_vertex: l.vertices[0],
+                length: l.length,
+                bbox: [[l.bbox.0.x, l.bbox.0.y, l.bbox.0.z], [l.bbox.1.x, l.bbox.1.y, l.bbox.1.z]],
+            })
+            .collect(),
+    }
+}
+
+/// What filling one loop found.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshFillReport {
+    /// The hole's number (from 1).
+    pub index: usize,
+    /// New vertices and triangles.
+    pub new_vertices: usize,
+    /// New triangles.
+    pub new_triangles: usize,
+    /// The collar's fit: vertices fitted, root mean square and largest residual.
+    pub collar_points: usize,
+    /// Root mean square residual.
+    pub collar_rms: f64,
+    /// Largest residual.
+    pub collar_max: f64,
+    /// The fill against the collar: G1 angle (radians), gap and curvature gap (relative
+    /// to the loop's radius), sampled along its boundary.
+    pub g1: f64,
+    /// Gap.
+    pub gap: f64,
+    /// Curvature gap.
+    pub g2: f64,
+    /// The largest dihedral angle across the former border (radians).
+    pub seam_dihedral: f64,
+    /// The shortest and longest new edge over the local median edge length.
+    pub edge_ratio: (f64, f64),
+}
+
+/// Fills the loops of `mf` that `o` asks for (every one asked must be fillable) and
+/// returns the mesh with the fills appended, and what each fill found.
+pub fn fill_mesh_holes(
+    mf: &MeshFile,
+    loops: &[MeshLoop],
+    o: &FillHolesOptions,
+) -> Result<(TriMesh, Vec<MeshFillReport>), String> {
+    if o.order != 4 && o.order != 6 {
+        return Err(format!("the order is 4 (G1) or 6 (G2), not {}", o.order));
+    }
+    let chosen: Vec<usize> = match &o.holes {
+        Some(list) => {
+            for &i in list {
+                if i == 0 || i > loops.len() {
+                    return Err(format!("hole {i} does not exist: the mesh has {} (numbered from 1)", loops.len()));
+                }
+            }
+            list.iter().map(|i| i - 1).collect()
+        }
+        None => (0..loops.len())
+            .filter(|&i| loops[i].kind == LoopKind::Simple)
+            .filter(|&i| o.max_edges.is_none_or(|n| loops[i].vertices.len() <= n))
+            .collect(),
+    };
+    let mut out = mf.mesh.clone();
+    let mut reports = Vec::with_capacity(chosen.len());
+    let lo = LoopFillOptions { order: o.order, ..Default::default() };
+    for i in chosen {
+        // each loop's collar is fitted to the input mesh: fills do not see each other
+        let f = fill_loop(&mf.mesh, &loops[i], out.positions.len() as u32, &lo)
+            .map_err(|e| format!("hole {}: {e}", i + 1))?;
+        reports.push(MeshFillReport {
+            index: i + 1,
+            new_vertices: f.positions.len(),
+            new_triangles: f.triangles.len(),
+            collar_points: f.fit.points,
+            collar_rms: f.fit.rms,
+            collar_max: max_nan(f.fit.max_residual, f.fit.loop_residual),
+            g1: f.continuity.g1,
+            gap: f.continuity.gap,
+            g2: f.continuity.g2,
+            seam_dihedral: f.seam_dihedral,
+            edge_ratio: f.edge_ratio,
+        });
+        out.positions.extend(&f.positions);
+        out.triangles.extend(&f.triangles);
+    }
+    Ok((out, reports))
+}
+
+/// Writes `m` to `path` in the format of its extension (`obj`, `ply`, `stl`), atomically.
+pub fn write_trimesh(path: &Path, m: &TriMesh) -> Result<(), String> {
+    let format = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(Format::from_extension)
+        .filter(|f| matches!(f, Format::Obj | Format::Ply | Format::Stl))
+        .ok_or_else(|| format!("{}: the output must be .obj, .ply or .stl", path.display()))?;
+    let mesh = Mesh {
+        name: "filled".into(),
+        positions: m.positions.clone(),
+        triangles: m.triangles.clone(),
+        ..Default::default()
+    };
+    write_meshes(path, format, &[&mesh]).map_err(|e| format!("{}: {e}", path.display()))
+}
