@@ -1,7 +1,7 @@
 """PDE-based shape design: exact PDE surfaces, blends and solids from numpy."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -18,15 +18,17 @@ class SceneError(Exception):
     message: str
 
 class ModelError(Exception):
-    """A model file (STEP) that cannot be read or whose holes cannot be filled; ``str(e)``
-    names the file, line and entity."""
+    """A model file (STEP or mesh) that cannot be read or whose holes cannot be filled;
+    ``str(e)`` names the file, line and entity (or element)."""
 
 def holes(path: Union[str, PathLike[str]], *, limits: Optional[Dict[str, int]] = None) -> Dict[str, Any]:
-    """The holes of a STEP model: the dict ``pdeshape holes MODEL --json`` prints."""
+    """The holes of a STEP model or a triangle mesh (.obj, .ply, .stl): the dict
+    ``pdeshape holes MODEL --json`` prints."""
     ...
 
+@overload
 def fill_holes(
-    path: Union[str, PathLike[str]],
+    model: Union[str, PathLike[str]],
     out: Union[str, PathLike[str]],
     *,
     order: int = 4,
@@ -36,8 +38,24 @@ def fill_holes(
     limits: Optional[Dict[str, int]] = None,
     time_limit: Optional[float] = None,
 ) -> List[Dict[str, Any]]:
-    """Fills the model's holes (order 4: G1, 6: G2) and writes it to ``out`` with the new
-    faces sewn in; one dict of figures per filled hole."""
+    """Fills the holes of a STEP model or mesh file (order 4: G1, 6: G2) and writes it to
+    ``out``; one dict of figures per filled hole."""
+    ...
+
+@overload
+def fill_holes(
+    model: npt.ArrayLike,
+    out: npt.ArrayLike,
+    *,
+    order: int = 4,
+    holes: Optional[List[int]] = None,
+    max_edges: Optional[int] = None,
+    relative_tolerance: float = 1e-7,
+    limits: Optional[Dict[str, int]] = None,
+    time_limit: Optional[float] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], List[Dict[str, Any]]]:
+    """Fills the holes of a mesh given as arrays (vertices (N, 3), faces (M, 3)); returns
+    the vertices and faces with the fills appended, and one dict per filled hole."""
     ...
 
 class Mesh:

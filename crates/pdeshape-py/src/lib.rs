@@ -645,9 +645,10 @@ fn model_error(e: impl std::fmt::Display) -> PyErr {
     ModelError::new_err(py_message(&e.to_string()))
 }
 
-/// The holes of a STEP model: the dict `pdeshape holes MODEL --json` prints (the loops of
-/// its free boundary, each with its edges, the faces around, length, bounding box and the
-/// angle between the faces at each corner).
+/// The holes of a model: the dict `pdeshape holes MODEL --json` prints. For a STEP model
+/// the loops of its free boundary, each with its edges, the faces around, length,
+/// bounding box and the angle between the faces at each corner; for a triangle mesh
+/// (.obj, .ply, .stl) its boundary loops with their edge counts, lengths and boxes.
 ///
 /// >>> pdeshape.holes("part.step")["holes"][0]["edges"]
 /// [21]
@@ -655,29 +656,41 @@ fn model_error(e: impl std::fmt::Display) -> PyErr {
 #[pyo3(signature = (path, *, limits=None))]
 fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyAny>> {
     let limits = limits_of(limits)?;
-    let report = py.detach(|| {
-        let m = pdeshape_io::import::step::read_step(&path, &limits)?;
+    let report = py.detach(|| -> Result<serde_json::Value, String> {
+        if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
+            let mf = pdeshape_io::import::mesh::read_mesh(&path, &limits).map_err(|e| e.to_string())?;
+            let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| format!("{}: {e}", mf.file))?;
+            return serde_json::to_value(pdeshape_io::mesh_holes::mesh_holes_report(&mf, &loops))
+                .map_err(|e| e.to_string());
+        }
+        let m = pdeshape_io::import::step::read_step(&path, &limits).map_err(|e| e.to_string())?;
         let hs = pdeshape_core::brep::holes(&m.brep);
-        Ok::<_, pdeshape_io::import::step::StepError>(pdeshape_io::holes::holes_report(&m, &hs))
+        serde_json::to_value(pdeshape_io::holes::holes_report(&m, &hs)).map_err(|e| e.to_string())
     });
-    let report = report.map_err(model_error)?;
-    to_python(py, &serde_json::to_value(&report).map_err(|e| PyRuntimeError::new_err(e.to_string()))?)
+    to_python(py, &report.map_err(model_error)?)
 }
 
-/// Fills the holes of the STEP model at `path` with fills of order 4 (G1) or 6 (G2) and
-/// writes it to `out` with the new faces sewn in, as `pdeshape fill-holes` does; returns
-/// one dict per filled hole (its number, the B-spline face's control points and measured
-/// deviation, and the seam's gap, normal angle and curvature gap measured on the written
-/// face). `holes` picks holes by their numbers in `pdeshape.holes` (from 1); `max_edges`
-/// leaves bigger loops open. Raises `ModelError` when the model cannot be read or an asked
-/// hole cannot be filled (nothing is written), `TimeoutError` past `time_limit` seconds.
+/// Fills holes with fills of order 4 (G1) or 6 (G2), as `pdeshape fill-holes` does.
+///
+/// - `fill_holes(path, out)`: a STEP model is written to `out` with the new faces sewn
+///   in; a triangle mesh (.obj, .ply, .stl) with the new triangles stitched to each hole's
+///   own vertices. Returns one dict of figures per filled hole.
+/// - `fill_holes(vertices, faces)`: a mesh as numpy arrays — float (N, 3) and integer
+///   (M, 3), counter-clockwise about the outside, as trimesh, pyvista and libigl hold
+///   them — returns `(vertices, faces, figures)`: the input rows first and unchanged, the
+///   fills' rows after them.
+///
+/// `holes` picks holes by their numbers in `pdeshape.holes` (from 1); `max_edges` leaves
+/// bigger loops open. Raises `ModelError` when the model cannot be read or an asked hole
+/// cannot be filled (nothing is written), `ValueError` for arrays of the wrong shape or
+/// indices out of range, `TimeoutError` past `time_limit` seconds.
 #[pyfunction]
-#[pyo3(signature = (path, out, *, order=4, holes=None, max_edges=None, relative_tolerance=1e-7, limits=None, time_limit=None))]
+#[pyo3(signature = (model, out, *, order=4, holes=None, max_edges=None, relative_tolerance=1e-7, limits=None, time_limit=None))]
 #[allow(clippy::too_many_arguments)]
 fn fill_holes(
     py: Python<'_>,
-    path: std::path::PathBuf,
-    out: std::path::PathBuf,
+    model: &Bound<'_, PyAny>,
+    out: &Bound<'_, PyAny>,
     order: usize,
     holes: Option<Vec<usize>>,
     max_edges: Option<usize>,
@@ -697,7 +710,22 @@ fn fill_holes(
         return Err(PyValueError::new_err("holes and max_edges do not go together: holes picks the holes itself"));
     }
     let o = pdeshape_io::holes::FillHolesOptions { order, holes, max_edges, relative: relative_tolerance };
+    let Ok(path) = model.extract::<std::path::PathBuf>() else {
+        return fill_mesh_arrays(py, model, out, &o, &limits, seconds);
+    };
+    let out: std::path::PathBuf = out.extract()?;
     let done = limited(py, seconds, "filling the holes", || -> Result<serde_json::Value, String> {
+        if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
+            let mf = pdeshape_io::import::mesh::read_mesh(&path, &limits).map_err(|e| e.to_string())?;
+            let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| format!("{}: {e}", mf.file))?;
+            let (filled, reports) =
+                pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, &o).map_err(|e| format!("{}: {e}", mf.file))?;
+            if reports.is_empty() {
+                return Err(format!("{}: no hole to fill", mf.file));
+            }
+            pdeshape_io::mesh_holes::write_trimesh(&out, &filled)?;
+            return serde_json::to_value(&reports).map_err(|e| e.to_string());
+        }
         let m = pdeshape_io::import::step::read_step(&path, &limits).map_err(|e| e.to_string())?;
         let hs = pdeshape_core::brep::holes(&m.brep);
         let filled = pdeshape_io::holes::fill_holes(&m, &hs, &o).map_err(|e| format!("{}: {e}", m.file))?;
@@ -721,6 +749,69 @@ fn fill_holes(
         ))
     })?;
     to_python(py, &done.map_err(model_error)?)
+}
+
+/// `fill_holes(vertices, faces)`: the arrays checked, the mesh filled, new arrays back.
+fn fill_mesh_arrays(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    o: &pdeshape_io::holes::FillHolesOptions,
+    limits: &Limits,
+    seconds: f64,
+) -> PyResult<Py<PyAny>> {
+    let np = py.import("numpy")?;
+    let v = np.call_method1("ascontiguousarray", (vertices, "float64"))?;
+    let f = np.call_method1("ascontiguousarray", (faces, "int64"))?;
+    let v: PyReadonlyArray2<'_, f64> =
+        v.extract().map_err(|_| PyValueError::new_err("vertices: a float array of shape (N, 3)"))?;
+    let f: PyReadonlyArray2<'_, i64> =
+        f.extract().map_err(|_| PyValueError::new_err("faces: an integer array of shape (M, 3)"))?;
+    let (va, fa) = (v.as_array(), f.as_array());
+    if va.ncols() != 3 {
+        return Err(PyValueError::new_err(format!("vertices: shape ({}, {}), not (N, 3)", va.nrows(), va.ncols())));
+    }
+    if fa.ncols() != 3 {
+        return Err(PyValueError::new_err(format!("faces: shape ({}, {}), not (M, 3)", fa.nrows(), fa.ncols())));
+    }
+    limits
+        .check(Cap::Entities, (va.nrows() + fa.nrows()) as u128, "the mesh's vertices and faces")
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let positions: Vec<Vec3> = va.rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect();
+    let mut triangles = Vec::with_capacity(fa.nrows());
+    for (i, r) in fa.rows().into_iter().enumerate() {
+        let mut t = [0u32; 3];
+        for k in 0..3 {
+            if r[k] < 0 || r[k] as usize >= positions.len() {
+                return Err(PyValueError::new_err(format!(
+                    "faces[{i}, {k}] = {}: out of range for {} vertices",
+                    r[k],
+                    positions.len()
+                )));
+            }
+            t[k] = r[k] as u32;
+        }
+        triangles.push(t);
+    }
+    let mf = pdeshape_io::import::mesh::MeshFile {
+        file: "the mesh".into(),
+        format: pdeshape_io::import::mesh::MeshFormat::Obj,
+        binary: false,
+        mesh: pdeshape_core::trimesh::TriMesh { positions, triangles },
+        polygons_split: 0,
+    };
+    let done = limited(py, seconds, "filling the holes", || {
+        let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| e.to_string())?;
+        pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, o)
+    })?;
+    let (m, reports) = done.map_err(model_error)?;
+    let verts = vec3s(py, &m.positions);
+    let tris: Vec<u32> = m.triangles.iter().flatten().copied().collect();
+    let tris = Array2::from_shape_vec((m.triangles.len(), 3), tris)
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?
+        .into_pyarray(py);
+    let figs = to_python(py, &serde_json::to_value(&reports).map_err(|e| PyRuntimeError::new_err(e.to_string()))?)?;
+    Ok((verts, tris, figs).into_pyobject(py)?.into_any().unbind())
 }
 
 /// PDE-based shape design: exact PDE surfaces, blends and solids (Bloor–Wilson's PDE

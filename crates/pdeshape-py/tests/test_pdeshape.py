@@ -341,3 +341,37 @@ def test_bad_models_and_arguments_raise(tmp_path):
     with pytest.raises(pdeshape.ModelError, match="limits=\\{'entities'"):
         pdeshape.holes(STEP / "cylinder-open.step", limits={"entities": 10})
     assert not (tmp_path / "o.step").exists()
+
+
+def _height_field_with_hole(k=40, r=0.35):
+    """A grid mesh of z = f(x, y) on [-1, 1]² with the triangles near the origin removed."""
+    f = lambda x, y: 0.3 * (x * x - 0.5 * y * y) + 0.1 * x * y  # noqa: E731
+    t = np.linspace(-1.0, 1.0, k + 1)
+    x, y = np.meshgrid(t, t)
+    v = np.column_stack([x.ravel(), y.ravel(), f(x, y).ravel()])
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    a = (i * (k + 1) + j).ravel()
+    tris = np.concatenate([np.column_stack([a, a + 1, a + k + 2]), np.column_stack([a, a + k + 2, a + k + 1])])
+    c = v[tris].mean(axis=1)
+    return v, tris[np.hypot(c[:, 0], c[:, 1]) >= r], f
+
+
+def test_fill_holes_of_numpy_arrays():
+    """A height field's hole filled at order 6 from arrays: the input rows come back first
+    and unchanged, only the outer rim (4 × 40 edges) stays open, the fill meets its collar
+    G1/G2 to round-off and lies near the true surface."""
+    v, f, height = _height_field_with_hole()
+    v2, f2, figs = pdeshape.fill_holes(v, f, order=6, max_edges=100)
+    assert np.array_equal(v2[: len(v)], v) and np.array_equal(f2[: len(f)], f)
+    assert v2.dtype == np.float64 and f2.shape[1] == 3
+    edges = np.sort(np.concatenate([f2[:, [0, 1]], f2[:, [1, 2]], f2[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert counts.max() == 2 and (counts == 1).sum() == 160
+    assert len(figs) == 1 and figs[0]["g1"] < 1e-12 and figs[0]["g2"] < 1e-10
+    new = v2[len(v):]
+    off = np.abs(new[:, 2] - height(new[:, 0], new[:, 1])).max()
+    assert off < 5e-3, off
+    with pytest.raises(ValueError, match=r"faces\[0, 2\] = 5000"):
+        pdeshape.fill_holes(v, np.array([[0, 1, 5000]]))
+    with pytest.raises(ValueError, match=r"vertices: shape \(3, 2\)"):
+        pdeshape.fill_holes(np.zeros((3, 2)), np.array([[0, 1, 2]]))
