@@ -140,6 +140,7 @@ pub struct CollarFit {
     pub period: f64,
     /// Vertices fitted (the loop's and those within `rings` rings of it).
     pub points: usize,
+
     /// Control points of each `D_k`.
     pub controls: usize,
     /// The spine's basis (fewer control points, for smooth curves along the loop).

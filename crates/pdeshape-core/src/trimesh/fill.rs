@@ -147,17 +147,16 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     }
     let continuity = fill.edge_continuity(64);
     let patch = fill.patch().clone();
-    // arc length from the loop to the pole, averaged over v
-    let (nsu, nsv) = (129, 32);
+    // arc length from the loop to the pole, averaged over v (on a grid: the patch's
+    // grid evaluation shares its work across rows and columns, scattered points do not)
+    let (nsu, nsv) = (65, 16);
     let us: Vec<f64> = (0..nsu).map(|i| i as f64 / (nsu - 1) as f64).collect();
     let vs: Vec<f64> = (0..nsv).map(|j| TAU * j as f64 / nsv as f64).collect();
+    let g = patch.grid(&us, &vs);
     let mut arc = vec![0.0; nsu];
-    for &v in &vs {
-        let mut prev = patch.point(0.0, v);
+    for j in 0..nsv {
         for i in 1..nsu {
-            let p = patch.point(us[i], v);
-            arc[i] += (p - prev).norm() / nsv as f64;
-            prev = p;
+            arc[i] += (g[i * nsv + j][0] - g[(i - 1) * nsv + j][0]).norm() / nsv as f64;
         }
     }
     for i in 1..nsu {
@@ -181,9 +180,9 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     let mut ring_prev = Vec::new();
     for j in 0..rings {
         let u = if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) };
-        let perim: f64 = (0..64)
-            .map(|k| (patch.point(u, TAU * (k + 1) as f64 / 64.0) - patch.point(u, TAU * k as f64 / 64.0)).norm())
-            .sum();
+        let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
+        let pts = patch.grid(&[u], &around);
+        let perim: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).norm()).sum();
         let nj = ((perim / h).round() as usize).max(3);
         let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
         // the fill's boundary gets the loop's own v: the band is a strip of quads
@@ -193,10 +192,12 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         } else {
             (0..nj).map(|k| TAU * (k as f64 + shift) / nj as f64).collect()
         };
+        let pts = patch.grid(&[u], &ring_v);
         let ring: Vec<(f64, f64, u32)> = ring_v
             .into_iter()
-            .map(|v| {
-                positions.push(patch.point(u, v));
+            .zip(pts)
+            .map(|(v, p)| {
+                positions.push(p[0]);
                 let y = if j == 0 { y_of_s(line.sigma(w0 + period * v / TAU)) } else { y_of_s(s_top) + u };
                 (v, y, base + positions.len() as u32 - 1)
             })
