@@ -6,6 +6,7 @@
 use crate::export::{Format, write_meshes};
 use crate::holes::FillHolesOptions;
 use crate::import::mesh::MeshFile;
+use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
 use pdeshape_core::trimesh::{LoopFillOptions, LoopKind, MeshLoop, TriMesh, dihedral_angles, fill_loop, quantile};
@@ -111,6 +112,7 @@ pub fn fill_mesh_holes(
     mf: &MeshFile,
     loops: &[MeshLoop],
     o: &FillHolesOptions,
+    limits: &Limits,
 ) -> Result<(TriMesh, Vec<MeshFillReport>), String> {
     if o.order != 4 && o.order != 6 {
         return Err(format!("the order is 4 (G1) or 6 (G2), not {}", o.order));
@@ -131,7 +133,7 @@ pub fn fill_mesh_holes(
     };
     let mut out = mf.mesh.clone();
     let mut reports = Vec::with_capacity(chosen.len());
-    let lo = LoopFillOptions { order: o.order, ..Default::default() };
+    let lo = LoopFillOptions { order: o.order, max_vertices: limits.vertices, ..Default::default() };
     for i in chosen {
         // each loop's collar is fitted to the input mesh: fills do not see each other
         let f = fill_loop(&mf.mesh, &loops[i], out.positions.len() as u32, &lo)

@@ -718,8 +718,8 @@ fn fill_holes(
         if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
             let mf = pdeshape_io::import::mesh::read_mesh(&path, &limits).map_err(|e| e.to_string())?;
             let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| format!("{}: {e}", mf.file))?;
-            let (filled, reports) =
-                pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, &o).map_err(|e| format!("{}: {e}", mf.file))?;
+            let (filled, reports) = pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, &o, &limits)
+                .map_err(|e| format!("{}: {e}", mf.file))?;
             if reports.is_empty() {
                 return Err(format!("{}: no hole to fill", mf.file));
             }
@@ -802,7 +802,7 @@ fn fill_mesh_arrays(
     };
     let done = limited(py, seconds, "filling the holes", || {
         let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| e.to_string())?;
-        pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, o)
+        pdeshape_io::mesh_holes::fill_mesh_holes(&mf, &loops, o, limits)
     })?;
     let (m, reports) = done.map_err(model_error)?;
     let verts = vec3s(py, &m.positions);

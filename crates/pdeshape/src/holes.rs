@@ -173,7 +173,7 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
         return Err(Usage(format!("{}: the output of a mesh must be .obj, .ply or .stl", out.display())).into());
     }
     let (mf, loops) = read_checked(path, limits)?;
-    let (filled, reports) = fill_mesh_holes(&mf, &loops, o).map_err(|e| anyhow!("{}: {e}", mf.file))?;
+    let (filled, reports) = fill_mesh_holes(&mf, &loops, o, limits).map_err(|e| anyhow!("{}: {e}", mf.file))?;
     if reports.is_empty() {
         return Err(anyhow!("{}: no hole to fill (`pdeshape holes` lists the loops)", mf.file));
     }

@@ -43,11 +43,14 @@ pub struct LoopFillOptions {
     pub order: usize,
     /// Rings of vertices around the loop that the collar is fitted to.
     pub rings: usize,
+    /// Most new vertices of one fill (the `vertices` cap: a loop long against its edges
+    /// would otherwise ask for a mesh of any size).
+    pub max_vertices: usize,
 }
 
 impl Default for LoopFillOptions {
     fn default() -> Self {
-        LoopFillOptions { order: 4, rings: 3 }
+        LoopFillOptions { order: 4, rings: 3, max_vertices: 4_000_000 }
     }
 }
 
@@ -91,6 +94,16 @@ pub enum LoopFillError {
     /// The fill turns over.
     #[error("the fill folds ({0} points of a 32 × 64 grid turn over)")]
     Folds(usize),
+    /// The fill's mesh would have more vertices than allowed.
+    #[error(
+        "the fill's mesh needs more than {limit} vertices (the loop is {ratio:.0} times its median edge length around); raise the cap with `--limit vertices=N`"
+    )]
+    TooManyVertices {
+        /// The cap.
+        limit: usize,
+        /// Loop length over median edge.
+        ratio: f64,
+    },
     /// The fill found a crease in the collar or dropped a piece.
     #[error("the collar has a crease or a piece without length")]
     Crease,
@@ -163,7 +176,12 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         arc[i] += arc[i - 1];
     }
     let total = arc[nsu - 1];
-    let rings = ((total / h).round() as usize).max(1);
+    let too_many = || LoopFillError::TooManyVertices { limit: o.max_vertices, ratio: lp.length / h };
+    let rings_f = (total / h).round();
+    if rings_f.is_nan() || rings_f > o.max_vertices as f64 {
+        return Err(too_many());
+    }
+    let rings = (rings_f as usize).max(1);
     let u_at = |target: f64| -> f64 {
         let i = arc.partition_point(|&a| a < target).clamp(1, nsu - 1);
         let (a0, a1) = (arc[i - 1], arc[i]);
@@ -183,7 +201,11 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
         let pts = patch.grid(&[u], &around);
         let perim: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).norm()).sum();
-        let nj = ((perim / h).round() as usize).max(3);
+        let nj_f = (perim / h).round();
+        if nj_f.is_nan() || nj_f + positions.len() as f64 > o.max_vertices as f64 {
+            return Err(too_many());
+        }
+        let nj = (nj_f as usize).max(3);
         let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
         // the fill's boundary gets the loop's own v: the band is a strip of quads
         let ring_v: Vec<f64> = if j == 0 {

@@ -23,7 +23,8 @@ fn sphere_cap_filled() {
     let own: Vec<f64> = dihedral_angles(&m).iter().map(|e| e.1).collect();
     let p99 = quantile(&own, 0.99);
     for order in [4, 6] {
-        let f = fill_loop(&m, &loops[0], m.positions.len() as u32, &LoopFillOptions { order, rings: 3 }).unwrap();
+        let f = fill_loop(&m, &loops[0], m.positions.len() as u32, &LoopFillOptions { order, ..Default::default() })
+            .unwrap();
         let closed = stitched(&m, &f);
         assert!(boundary(&closed).unwrap().is_empty(), "order {order}: the hole is closed, orientation consistent");
         let off = f.positions.iter().fold(0.0, |a: f64, p| max_nan(a, (p.norm() - 1.0).abs()));
@@ -57,6 +58,17 @@ fn sphere_cap_filled() {
         // the least-bending fill is flatter than the sphere: its pole lies 5e-3 inside
         assert!(off < 6e-3, "{off}");
     }
+}
+
+/// A fill whose mesh would pass the vertex cap is refused before it is built (a loop long
+/// against the edges around it: here the cap is set low).
+#[test]
+fn vertex_cap_refuses_big_fills() {
+    let m = cut_cap(&icosphere(4), Vec3::new(0.0, 0.0, 1.0), 30f64.to_radians());
+    let loops = boundary(&m).unwrap();
+    let o = LoopFillOptions { max_vertices: 50, ..Default::default() };
+    let e = fill_loop(&m, &loops[0], m.positions.len() as u32, &o).err().unwrap();
+    assert!(matches!(e, LoopFillError::TooManyVertices { limit: 50, .. }), "{e}");
 }
 
 /// Bad topology is named by its element.
