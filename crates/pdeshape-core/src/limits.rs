@@ -31,9 +31,9 @@ pub enum Cap {
     Memory,
     /// Size of a scene file, MiB.
     Scene,
-    /// Size of an imported model file (STEP), MiB.
+    /// Size of an imported model file (STEP or mesh), MiB.
     Model,
-    /// Entities of an imported model file.
+    /// Entities of an imported STEP model; vertices plus faces of a mesh file.
     Entities,
 }
 

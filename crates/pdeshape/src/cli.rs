@@ -20,9 +20,9 @@ pub struct Cli {
     quiet: bool,
     /// Raise or lower a cap on what a scene may ask for: order (PDE order, default 64),
     /// modes (Fourier modes, sine terms, bubbles, solid terms; 512), collocation (points
-    /// of one solve; 250000), vertices (per patch; 4000000), memory (MiB of meshes; 4096),
-    /// scene (MiB of a scene file; 16), model (MiB of a STEP model; 256), entities (of a
-    /// STEP model; 4000000).
+    /// of one solve; 250000), vertices (per patch or hole fill; 4000000), memory (MiB of
+    /// meshes; 4096), scene (MiB of a scene file; 16), model (MiB of a STEP model or mesh
+    /// file; 256), entities (of a STEP model, or vertices and faces of a mesh; 4000000).
     #[arg(long = "limit", global = true, value_name = "CAP=VALUE", value_parser = limit)]
     limit: Vec<String>,
     /// Longest time in seconds: for build, check, sample and render the whole command
