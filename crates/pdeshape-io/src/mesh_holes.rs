@@ -9,7 +9,9 @@ use crate::import::mesh::MeshFile;
 use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
-use pdeshape_core::trimesh::{LoopFillOptions, LoopKind, MeshLoop, TriMesh, dihedral_angles, fill_loop, quantile};
+use pdeshape_core::trimesh::{
+    LoopFillOptions, LoopKind, MeshLoop, TriMesh, crossings, dihedral_angles, fill_loop, quantile,
+};
 use serde::Serialize;
 use std::path::Path;
 
@@ -107,7 +109,9 @@ pub struct MeshFillReport {
 }
 
 /// Fills the loops of `mf` that `o` asks for (every one asked must be fillable) and
-/// returns the mesh with the fills appended, and what each fill found.
+/// returns the mesh with the fills appended, and what each fill found. A fill whose
+/// triangles would cross the mesh, an earlier fill or each other is an error, not a
+/// fill ([`pdeshape_core::trimesh::crossings`]).
 pub fn fill_mesh_holes(
     mf: &MeshFile,
     loops: &[MeshLoop],
@@ -132,6 +136,9 @@ pub fn fill_mesh_holes(
             .collect(),
     };
     let mut out = mf.mesh.clone();
+    let input = out.triangles.len();
+    // (first triangle, hole number) of each fill appended
+    let mut owner: Vec<(usize, usize)> = Vec::new();
     let mut reports = Vec::with_capacity(chosen.len());
     let lo = LoopFillOptions { order: o.order, max_vertices: limits.vertices, ..Default::default() };
     for i in chosen {
@@ -151,8 +158,26 @@ pub fn fill_mesh_holes(
             seam_dihedral: f.seam_dihedral,
             edge_ratio: f.edge_ratio,
         });
+        let first = out.triangles.len();
         out.positions.extend(&f.positions);
         out.triangles.extend(&f.triangles);
+        // no new triangle may cross the input or an earlier fill, nor another of its own
+        if let Some(&(t, u)) = crossings(&out, first, 1).first() {
+            let other = if u >= first {
+                format!("its own triangle {}", u - first)
+            } else if u >= input {
+                let j = owner.iter().rev().find(|o| o.0 <= u).map_or(0, |o| o.1);
+                format!("a triangle of hole {j}'s fill")
+            } else {
+                format!("input triangle {u}")
+            };
+            return Err(format!(
+                "hole {}: the fill would cross the mesh (its triangle {} crosses {other}); not filled (choose holes with --holes)",
+                i + 1,
+                t - first
+            ));
+        }
+        owner.push((first, i + 1));
     }
     Ok((out, reports))
 }

@@ -135,3 +135,38 @@ fn bad_meshes_refused() {
     let o = run(&["fill-holes", m.to_str().unwrap(), "-o", dir.path().join("m.step").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// A small closed ball (no loops of its own) sits where the sphere's hole is: the fill
+/// would pass through it, so the hole is reported, not filled, exit 1, nothing written.
+/// Without the ball the same hole fills.
+#[test]
+fn a_fill_that_would_cross_the_mesh_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = Vec3::new(0.3, 0.2, 0.9).normalized().unwrap();
+    let sphere = cut_cap(&icosphere(4), d, 30f64.to_radians());
+    let ball = icosphere(1);
+    let mut m = sphere.clone();
+    let base = m.positions.len() as u32;
+    // radius 0.08 about the true sphere's point: the fill, within ~1e-2 of the sphere
+    // there, passes through the ball
+    m.positions.extend(ball.positions.iter().map(|&p| d + p * 0.08));
+    m.triangles.extend(ball.triangles.iter().map(|t| t.map(|i| i + base)));
+    assert_eq!(boundary(&m).unwrap().len(), 1);
+    let input = dir.path().join("blocked.obj");
+    let out = dir.path().join("out.obj");
+    write_obj(&input, &m);
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("hole 1: the fill would cross the mesh") && err.contains("input triangle"), "{err}");
+    assert!(!out.exists());
+    // the ball moved inside the sphere, clear of the fill: filled
+    let mut clear = sphere;
+    let base = clear.positions.len() as u32;
+    clear.positions.extend(ball.positions.iter().map(|&p| d * 0.5 + p * 0.08));
+    clear.triangles.extend(ball.triangles.iter().map(|t| t.map(|i| i + base)));
+    write_obj(&input, &clear);
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.exists());
+}

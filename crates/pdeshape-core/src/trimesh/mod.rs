@@ -7,14 +7,17 @@
 //! the surface around the loop is estimated by a [`Collar`] fitted to the vertices within
 //! a few rings of it, the fill meets the collar G1/G2 along the loop, and the fill is
 //! meshed at the density of the mesh around it and stitched to the loop's own vertices.
+//! [`crossings`] checks that no new triangle crosses another.
 
 mod collar;
+mod crossing;
 mod fill;
 mod loops;
 mod periodic;
 pub mod shapes;
 
 pub use collar::{Collar, CollarError, CollarFit, adjacency, fit_collar};
+pub use crossing::{crossings, triangles_cross};
 pub use fill::{LoopFill, LoopFillError, LoopFillOptions, fill_loop};
 pub use loops::{LoopKind, MeshLoop, TopologyError, boundary, dihedral_angles, quantile};
 pub use periodic::PeriodicSpline;
