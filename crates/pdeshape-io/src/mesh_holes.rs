@@ -40,8 +40,12 @@ pub struct MeshHolesReport {
 pub struct MeshHoleReport {
     /// Its number (from 1), as `--holes` takes it.
     pub index: usize,
-    /// `hole` or `touches itself`.
+    /// `hole`, `rim` (of an open sheet), `open end` (of a tube or handle, or a bowl's rim)
+    /// or `touches itself`; only holes are filled unless asked for by number.
     pub kind: &'static str,
+    /// The mean unit normal of the mesh at the loop along the loop's axis: −1 around a
+    /// hole, +1 along a rim, near 0 at an open end.
+    pub facing: f64,
     /// Its number of edges.
     pub edges: usize,
     /// Its first vertex (from 0), where it starts.
@@ -67,10 +71,8 @@ pub fn mesh_holes_report(mf: &MeshFile, loops: &[MeshLoop]) -> MeshHolesReport {
             .enumerate()
             .map(|(i, l)| MeshHoleReport {
                 index: i + 1,
-                kind: match l.kind {
-                    LoopKind::Simple => "hole",
-                    LoopKind::TouchesItself => "touches itself",
-                },
+                kind: l.kind.name(),
+                facing: l.facing,
                 edges: l.vertices.len(),
                 first_vertex: l.vertices[0],
                 length: l.length,
@@ -131,7 +133,7 @@ pub fn fill_mesh_holes(
             list.iter().map(|i| i - 1).collect()
         }
         None => (0..loops.len())
-            .filter(|&i| loops[i].kind == LoopKind::Simple)
+            .filter(|&i| loops[i].kind == LoopKind::Hole)
             .filter(|&i| o.max_edges.is_none_or(|n| loops[i].vertices.len() <= n))
             .collect(),
     };

@@ -150,9 +150,10 @@ fn list_mesh(path: &Path, json: bool, limits: &Limits) -> Result<()> {
     );
     for h in &r.holes {
         println!(
-            "hole {}: {}, {} edges from vertex {}, length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
+            "hole {}: {} (facing {:+.2}), {} edges from vertex {}, length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
             h.index,
             h.kind,
+            h.facing,
             h.edges,
             h.first_vertex,
             h.length,

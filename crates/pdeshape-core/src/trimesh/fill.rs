@@ -111,7 +111,7 @@ pub enum LoopFillError {
 
 /// Fills loop `lp` of `m`; the new vertices are numbered from `base`.
 pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> Result<LoopFill, LoopFillError> {
-    if lp.kind != LoopKind::Simple {
+    if lp.kind == LoopKind::TouchesItself {
         return Err(LoopFillError::NotSimple);
     }
     let n = lp.vertices.len();

@@ -6,6 +6,18 @@
 //! their left: a loop is a cycle of them, run the way the mesh runs them. A vertex where
 //! more than one boundary half-edge leaves (two holes meeting at a point, or a loop that
 //! pinches) makes its loops [`LoopKind::TouchesItself`].
+//!
+//! **Hole, rim or open end.** Topology alone cannot tell a hole from the rim of an open
+//! sheet: both are a loop with the mesh on one side. Geometry can. Let `A = ½ Σ pᵢ × pᵢ₊₁`
+//! be the loop's vector area (its axis, by the right-hand rule along the loop) and `N` the
+//! sum of the (area-weighted) normals of the triangles at its vertices. Running with the
+//! mesh on its left, a loop goes clockwise about the mesh's normal around a hole (the
+//! mesh lies outside it) and counter-clockwise along a rim (the mesh lies inside), so the
+//! facing `f = Â · N / Σ|nₜ|` — the mean unit normal's component along the loop's axis —
+//! is near −1 for a hole in a gently curved surface and near +1 for a rim. Around a tube
+//! or a handle (a cylinder's end), or the rim of a bowl, the normals lie across the axis
+//! and `f` is near 0. The loop is a hole for `f ≤ −⅓`, a rim for `f ≥ ⅓`, an open end
+//! between: a spherical cap hole of half-angle θ gives `f = −cos θ`, a hole up to 70°.
 
 use super::TriMesh;
 use crate::Vec3;
@@ -75,9 +87,13 @@ pub enum TopologyError {
 /// What a boundary loop is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LoopKind {
-    /// A simple closed loop: a hole (or the rim of an open surface: the mesh does not tell
-    /// them apart; `--max-edges` leaves big loops open).
-    Simple,
+    /// A simple loop with the mesh around it, facing `f ≤ −⅓`: a hole.
+    Hole,
+    /// A simple loop around the mesh, facing `f ≥ ⅓`: the rim of an open sheet.
+    Rim,
+    /// A simple loop with the normals across its axis, `|f| < ⅓`: the end of a tube, a
+    /// cut through a handle, the rim of a bowl.
+    OpenEnd,
     /// The loop passes a vertex where more than one boundary edge leaves.
     TouchesItself,
 }
@@ -93,6 +109,20 @@ pub struct MeshLoop {
     pub length: f64,
     /// Its bounding box.
     pub bbox: (Vec3, Vec3),
+    /// The facing `f` (see the module's documentation): −1 a hole, +1 a rim.
+    pub facing: f64,
+}
+
+impl LoopKind {
+    /// How `holes` names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            LoopKind::Hole => "hole",
+            LoopKind::Rim => "rim",
+            LoopKind::OpenEnd => "open end",
+            LoopKind::TouchesItself => "touches itself",
+        }
+    }
 }
 
 /// Checks that `m` is an oriented 2-manifold with boundary and returns its boundary loops
@@ -181,10 +211,50 @@ pub fn boundary(m: &TriMesh) -> Result<Vec<MeshLoop>, TopologyError> {
         let pts: Vec<Vec3> = vertices.iter().map(|&i| m.positions[i as usize]).collect();
         let length = (0..pts.len()).map(|i| (pts[(i + 1) % pts.len()] - pts[i]).norm()).sum();
         let bbox = pts.iter().fold((pts[0], pts[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let kind = if pinched { LoopKind::TouchesItself } else { LoopKind::Simple };
-        loops.push(MeshLoop { vertices, kind, length, bbox });
+        // simple loops are told apart by `classify`
+        let kind = if pinched { LoopKind::TouchesItself } else { LoopKind::Hole };
+        loops.push(MeshLoop { vertices, kind, length, bbox, facing: f64::NAN });
     }
+    classify(m, &mut loops);
     Ok(loops)
+}
+
+/// Sets the facing of every loop, and the kind of the simple ones.
+fn classify(m: &TriMesh, loops: &mut [MeshLoop]) {
+    let mut on_loop: HashMap<u32, (Vec3, f64)> = HashMap::new();
+    for l in loops.iter() {
+        for &v in &l.vertices {
+            on_loop.insert(v, (Vec3::ZERO, 0.0));
+        }
+    }
+    for (t, tri) in m.triangles.iter().enumerate() {
+        let n = m.face_normal(t);
+        for v in tri {
+            if let Some(acc) = on_loop.get_mut(v) {
+                acc.0 += n;
+                acc.1 += n.norm();
+            }
+        }
+    }
+    for l in loops.iter_mut() {
+        let p = |i: usize| m.positions[l.vertices[i % l.vertices.len()] as usize];
+        // about the loop's first vertex, to keep the cross products small
+        let area: Vec3 = (1..l.vertices.len()).map(|i| (p(i) - p(0)).cross(p(i + 1) - p(0))).sum::<Vec3>() * 0.5;
+        let (n, total) = l.vertices.iter().fold((Vec3::ZERO, 0.0), |(n, s), v| (n + on_loop[v].0, s + on_loop[v].1));
+        l.facing = match area.normalized() {
+            Some(axis) if total > 0.0 => axis.dot(n) / total,
+            _ => 0.0,
+        };
+        if l.kind != LoopKind::TouchesItself {
+            l.kind = if l.facing <= -1.0 / 3.0 {
+                LoopKind::Hole
+            } else if l.facing >= 1.0 / 3.0 {
+                LoopKind::Rim
+            } else {
+                LoopKind::OpenEnd
+            };
+        }
+    }
 }
 
 /// The angle (radians) between the normals of the two triangles of every interior edge,

@@ -19,7 +19,7 @@ fn sphere_cap_filled() {
     let m = cut_cap(&icosphere(4), Vec3::new(0.3, 0.2, 0.9).normalized().unwrap(), 30f64.to_radians());
     let loops = boundary(&m).unwrap();
     assert_eq!(loops.len(), 1);
-    assert_eq!(loops[0].kind, LoopKind::Simple);
+    assert_eq!(loops[0].kind, LoopKind::Hole);
     let own: Vec<f64> = dihedral_angles(&m).iter().map(|e| e.1).collect();
     let p99 = quantile(&own, 0.99);
     for order in [4, 6] {
@@ -112,5 +112,52 @@ fn collar_fits_plane_and_paraboloid() {
         let fit = fit_collar(&m, &adjacency(&m), hole, 3).unwrap();
         assert!(fit.rms < 3e-4 && fit.max_residual < 1e-3, "{name}: rms {:.2e} max {:.2e}", fit.rms, fit.max_residual);
         assert!(fit.cond < 1e8, "{name}: {:e}", fit.cond);
+    }
+}
+
+/// Holes, rims and open ends told apart by their facing, against the values worked out by
+/// hand: a cap hole of half-angle θ faces `−cos θ` and the rim left by removing all but
+/// a cap of half-angle φ faces `+cos φ` (the normals at the loop make angle θ (φ) with its
+/// axis); a height field's outer rim faces about +1 and its hole about −1; both ends of an
+/// open cylinder face 0 (normals across the axis). The one ring of triangles at the loop
+/// tilts the mean normal by about half an edge's angle (0.008–0.014 seen at this level),
+/// hence 0.03.
+#[test]
+fn holes_rims_and_open_ends() {
+    let d = Vec3::new(0.3, 0.2, 0.9).normalized().unwrap();
+    for (theta, kind) in
+        [(30.0, LoopKind::Hole), (60.0, LoopKind::Hole), (120.0, LoopKind::Rim), (150.0, LoopKind::Rim)]
+    {
+        let theta = f64::to_radians(theta);
+        let loops = boundary(&cut_cap(&icosphere(5), d, theta)).unwrap();
+        assert_eq!(loops.len(), 1);
+        assert_eq!(loops[0].kind, kind, "θ = {theta}");
+        assert!((loops[0].facing + theta.cos()).abs() < 0.03, "θ = {theta}: facing {}", loops[0].facing);
+    }
+    let loops = boundary(&height_grid(40, 0.4, |x, y| 0.2 * x * y)).unwrap();
+    let kinds: Vec<LoopKind> = loops.iter().map(|l| l.kind).collect();
+    assert!(kinds.contains(&LoopKind::Hole) && kinds.contains(&LoopKind::Rim), "{kinds:?}");
+    assert!(loops.iter().all(|l| l.facing.abs() > 0.97), "{loops:?}");
+    // an open cylinder of radius 1 and height 2, 48 × 12 quads split
+    let (k, rows) = (48usize, 12usize);
+    let mut cyl = TriMesh::default();
+    for i in 0..=rows {
+        for j in 0..k {
+            let a = std::f64::consts::TAU * j as f64 / k as f64;
+            cyl.positions.push(Vec3::new(a.cos(), a.sin(), 2.0 * i as f64 / rows as f64));
+        }
+    }
+    let id = |i: usize, j: usize| (i * k + j % k) as u32;
+    for i in 0..rows {
+        for j in 0..k {
+            cyl.triangles.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
+            cyl.triangles.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    let loops = boundary(&cyl).unwrap();
+    assert_eq!(loops.len(), 2);
+    for l in &loops {
+        assert_eq!(l.kind, LoopKind::OpenEnd);
+        assert!(l.facing.abs() < 1e-12, "{}", l.facing);
     }
 }
