@@ -6,6 +6,7 @@
 use crate::export::{Format, write_meshes};
 use crate::holes::FillHolesOptions;
 use crate::import::mesh::MeshFile;
+use pdeshape_core::Vec3;
 use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
@@ -106,6 +107,14 @@ pub struct MeshFillReport {
     pub g2: f64,
     /// The largest dihedral angle across the former border (radians).
     pub seam_dihedral: f64,
+    /// The fill's fullness (its cross tangent against the loop's mean radius) and pole
+    /// height (factor on the least-bending pole's offset), chosen for least Willmore
+    /// energy.
+    pub fullness: f64,
+    /// Pole height.
+    pub height: f64,
+    /// Its Willmore energy `∫ H² dA`.
+    pub willmore: f64,
     /// The shortest and longest new edge over the local median edge length.
     pub edge_ratio: (f64, f64),
 }
@@ -158,6 +167,9 @@ pub fn fill_mesh_holes(
             gap: f.continuity.gap,
             g2: f.continuity.g2,
             seam_dihedral: f.seam_dihedral,
+            fullness: f.fullness,
+            height: f.height,
+            willmore: f.willmore,
             edge_ratio: f.edge_ratio,
         });
         let first = out.triangles.len();
@@ -199,4 +211,41 @@ pub fn write_trimesh(path: &Path, m: &TriMesh) -> Result<(), String> {
         ..Default::default()
     };
     write_meshes(path, format, &[&mesh]).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The smooth-shading normals of `m`: at each vertex the sum of its triangles' normals
+/// weighted by their angle there (the weighting that makes the normal of a vertex on a
+/// smooth surface independent of how the triangles around it are cut), normalised.
+pub fn vertex_normals(m: &TriMesh) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; m.positions.len()];
+    for t in 0..m.triangles.len() {
+        let Some(unit) = m.face_normal(t).normalized() else { continue };
+        let tri = m.triangles[t];
+        for k in 0..3 {
+            let p = m.positions[tri[k] as usize];
+            let (a, b) = (m.positions[tri[(k + 1) % 3] as usize] - p, m.positions[tri[(k + 2) % 3] as usize] - p);
+            let angle = a.cross(b).norm().atan2(a.dot(b));
+            n[tri[k] as usize] += unit * angle;
+        }
+    }
+    n.into_iter().map(|v| v.normalized().unwrap_or(Vec3::ZERO)).collect()
+}
+
+/// `m` as a picture in the view of `r` (shaded, zebra stripes or isophotes: a mesh file
+/// carries no exact curvature), smooth-shaded with [`vertex_normals`].
+pub fn render_trimesh(m: &TriMesh, r: &crate::scene::RenderSettings) -> Result<crate::render::Image, String> {
+    if r.view.curvature().is_some() {
+        return Err(format!(
+            "a mesh file renders shaded, zebra or isophotes: the {} view needs a scene's exact curvature",
+            r.view.name()
+        ));
+    }
+    let mesh = Mesh {
+        name: "mesh".into(),
+        positions: m.positions.clone(),
+        normals: vertex_normals(m),
+        triangles: m.triangles.clone(),
+        ..Default::default()
+    };
+    Ok(crate::model::render_meshes(&[mesh], &[], &[], r))
 }

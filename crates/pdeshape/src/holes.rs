@@ -9,7 +9,7 @@ use pdeshape_core::trimesh::{MeshLoop, boundary};
 use pdeshape_io::holes::{FillHolesOptions, fill_holes, holes_report, write_filled};
 use pdeshape_io::import::mesh::{MeshFile, MeshFormat, read_mesh};
 use pdeshape_io::import::step::{StepModel, read_step};
-use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, write_trimesh};
+use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, render_trimesh, write_trimesh};
 use std::path::Path;
 
 fn is_step(p: &Path) -> bool {
@@ -187,7 +187,7 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
         for f in &reports {
             let g2 = if o.order == 6 { format!(", curvature gap {:.3e}", f.g2) } else { String::new() };
             eprintln!(
-                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
+                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; fullness {:.3}, pole height {:.3} (Willmore energy {:.4e}); seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
                 f.index,
                 o.order,
                 f.new_vertices,
@@ -197,6 +197,9 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
                 f.collar_points,
                 f.g1,
                 f.gap,
+                f.fullness,
+                f.height,
+                f.willmore,
                 f.seam_dihedral,
                 r.dihedral_p99,
                 f.edge_ratio.0,
@@ -206,4 +209,22 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
         eprintln!("wrote {}", out.display());
     }
     Ok(())
+}
+
+/// `render` on a triangle mesh file.
+pub fn render_mesh(
+    path: &Path,
+    r: &pdeshape_io::scene::RenderSettings,
+    limits: &Limits,
+) -> Result<pdeshape_io::render::Image> {
+    if r.view.curvature().is_some() {
+        return Err(Usage(format!(
+            "{}: a mesh file renders shaded, zebra or isophotes; the {} view needs a scene's exact curvature",
+            path.display(),
+            r.view.name()
+        ))
+        .into());
+    }
+    let mf = read_mesh(path, limits)?;
+    render_trimesh(&mf.mesh, r).map_err(|e| anyhow!("{}: {e}", mf.file))
 }

@@ -1,8 +1,9 @@
 //! A field whose one-slot derivatives are kept by the parameters asked for: for boundary
 //! data that cost much per point (an N-sided fill's loop on CAD faces: each point a foot
 //! curve and a reparametrisation in truncated Taylor arithmetic) and that grids ask for
-//! at the same `v` again and again (every cell of a fit's row of cells). The values are
-//! the inner field's, bit for bit.
+//! at the same `v` again and again (every cell of a fit's row of cells), and jets at up
+//! to three parameters (a mesh hole's collar, asked at the same points by the fills of
+//! several fullnesses). The values are the inner field's, bit for bit.
 
 use super::{Field, FieldRef, VecJet};
 use crate::Vec3;
@@ -13,16 +14,21 @@ use std::sync::Arc;
 /// Keys: the first two slots' bits, the slot, the number of derivatives.
 type Key = (u64, u64, usize, usize);
 
-/// `inner` with its [`Field::derivatives_in`] memoised (at most 16 384 results kept).
+/// Jet keys: the three slots' bits and the shape.
+type JetKey = ([u64; 3], JetShape);
+
+/// `inner` with its [`Field::derivatives_in`] and [`Field::jet`] (at up to three slots)
+/// memoised (at most 16 384 results of each kept).
 pub struct MemoField {
     inner: FieldRef,
     memo: BoundedMemo<Key, Arc<[Vec3]>>,
+    jets: BoundedMemo<JetKey, Arc<VecJet>>,
 }
 
 impl MemoField {
     /// Wraps `inner`.
     pub fn new(inner: FieldRef) -> Self {
-        MemoField { inner, memo: BoundedMemo::new(16_384) }
+        MemoField { inner, memo: BoundedMemo::new(16_384), jets: BoundedMemo::new(16_384) }
     }
 }
 
@@ -37,7 +43,21 @@ impl Field for MemoField {
         self.inner.arity()
     }
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
-        self.inner.jet(at, shape)
+        if at.len() > 3 {
+            return self.inner.jet(at, shape);
+        }
+        let mut bits = [0; 3];
+        for (b, x) in bits.iter_mut().zip(at) {
+            *b = x.to_bits();
+        }
+        // a different number of slots at the same values is another point of another field
+        let key = ([bits[0], bits[1], bits[2] ^ ((at.len() as u64) << 60)], shape);
+        if let Some(j) = self.jets.get(&key) {
+            return (*j).clone();
+        }
+        let j = self.inner.jet(at, shape);
+        self.jets.insert(key, Arc::new(j.clone()));
+        j
     }
     fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
         // only the slots a key holds (later slots would be ignored by it)
@@ -77,6 +97,7 @@ mod tests {
             2
         }
         fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+            self.1.fetch_add(1, Ordering::Relaxed);
             self.0.jet(at, shape)
         }
         fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
@@ -102,5 +123,13 @@ mod tests {
             }
         }
         assert_eq!(inner.1.load(Ordering::Relaxed), 6);
+        for _ in 0..3 {
+            for v in [0.1, 0.7] {
+                for shape in [JetShape::new(&[2, 1]), JetShape::new(&[1, 1])] {
+                    assert_eq!(m.jet(&[v, 0.5], shape), e.jet(&[v, 0.5], shape));
+                }
+            }
+        }
+        assert_eq!(inner.1.load(Ordering::Relaxed), 10, "each jet asked once per point and shape");
     }
 }

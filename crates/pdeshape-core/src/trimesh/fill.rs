@@ -60,6 +60,14 @@ pub struct LoopFill {
     pub fit: CollarFit,
     /// The fill.
     pub fill: Fill,
+    /// Its fullness (cross tangent against the loop's mean radius) and pole height (factor
+    /// on the least-bending pole's offset from the centroid), chosen for least Willmore
+    /// energy (see [`fill_loop`]).
+    pub fullness: f64,
+    /// Its pole height.
+    pub height: f64,
+    /// Its Willmore energy `∫ H² dA`.
+    pub willmore: f64,
     /// New vertices, to be appended to the mesh's (their indices start at the `base`
     /// given to [`fill_loop`]).
     pub positions: Vec<Vec3>,
@@ -109,7 +117,9 @@ pub enum LoopFillError {
     Crease,
 }
 
-/// Fills loop `lp` of `m`; the new vertices are numbered from `base`.
+/// Fills loop `lp` of `m`; the new vertices are numbered from `base`. Of the fills that
+/// meet the collar G1 (G2), differing in the length of their cross tangent and the height
+/// of their pole, the one of least Willmore energy is taken (`fairest`).
 pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> Result<LoopFill, LoopFillError> {
     if lp.kind == LoopKind::TouchesItself {
         return Err(LoopFillError::NotSimple);
@@ -139,18 +149,24 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         host: Host::Field(Arc::new(fit.collar.clone())),
         curve: DomainCurve::Field(Arc::new(line.clone())),
     };
-    let surface: FieldRef = Arc::new(along);
+    // the fills of several fullnesses ask the collar at the same points: kept per point
+    let surface: FieldRef = Arc::new(crate::data::MemoField::new(Arc::new(along)));
     // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
-    let edges: Vec<FillEdge> = (0..4)
-        .map(|k| FillEdge {
-            surface: surface.clone(),
-            s0: 0.0,
-            w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
-            fullness: 1.0,
-            side: Some(1.0),
-        })
-        .collect();
-    let fill = Fill::new(&edges, &FillOptions { order: o.order, ..FillOptions::default() })?;
+    let make = |[f, height]: [f64; 2]| -> Result<(Fill, f64), LoopFillError> {
+        let edges: Vec<FillEdge> = (0..4)
+            .map(|k| FillEdge {
+                surface: surface.clone(),
+                s0: 0.0,
+                w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
+                fullness: f,
+                side: Some(1.0),
+            })
+            .collect();
+        let fill = Fill::new(&edges, &FillOptions { order: o.order, height, ..FillOptions::default() })?;
+        let e = willmore(fill.patch().as_ref(), 16, 48);
+        Ok((fill, e))
+    };
+    let (fill, [fullness, height], willmore_energy) = fairest(make)?;
     if !fill.report().dropped_edges.is_empty() || !fill.report().split_edges.is_empty() {
         return Err(LoopFillError::Crease);
     }
@@ -263,7 +279,19 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         let ang = n1.cross(n2).norm().atan2(n1.dot(n2));
         seam_dihedral = max_nan(seam_dihedral, ang);
     }
-    Ok(LoopFill { fit, fill, positions, triangles, continuity, seam_dihedral, edge_length: h, edge_ratio })
+    Ok(LoopFill {
+        fit,
+        fill,
+        fullness,
+        height,
+        willmore: willmore_energy,
+        positions,
+        triangles,
+        continuity,
+        seam_dihedral,
+        edge_length: h,
+        edge_ratio,
+    })
 }
 
 /// The fill's boundary in the collar's domain: `σ̄`, a spline on the spine's breakpoints
@@ -390,5 +418,119 @@ fn zip(a: &[(f64, f64, u32)], b: &[(f64, f64, u32)], pos: &dyn Fn(u32) -> Vec3, 
             out.push([a[i % na].2, b[k % nb].2, b[(k + 1) % nb].2]);
             k += 1;
         }
+    }
+}
+
+/// The fill of least Willmore energy `∫ H² dA` among those of fullness `f` (the length
+/// of the cross tangent against the loop's mean radius) and pole height `h` (the factor
+/// on the least-bending pole's offset from the loop's centroid), `make` giving the fill
+/// and its energy for `[f, h]`. From `(1, 1)`, two rounds of coordinate descent: in each
+/// coordinate the energy at `x ± δ`, the vertex of the parabola through the three (when
+/// it opens upwards; within `3δ` and the bounds `f ∈ [0.5, 2]`, `h ∈ [0, 4]`), and the
+/// lowest point kept; `δ = (0.15, 0.4)`, halved for the second round. Returns the fill,
+/// `[f, h]` and its energy.
+///
+/// Why this energy: G1 fixes the fill's boundary and tangent planes, so by Gauss–Bonnet
+/// `∫ K dA` is fixed and `∫ (κ₁² + κ₂²) dA = ∫ (4H² − 2K) dA` differs from `4 ∫ H² dA`
+/// by a constant: the fairest fill bends least. A sphere is a critical point of it, and
+/// for a nearly flat surface `z(x, y)` it is `¼ ∫ (Δz)²`, whose minimisers (biharmonic
+/// `z`) include every quadratic — what a hole in a smooth surface should be filled with.
+/// `f` and `h` are what the G1/G2 conditions leave free to the fill's construction.
+#[allow(clippy::type_complexity)]
+fn fairest(
+    make: impl Fn([f64; 2]) -> Result<(Fill, f64), LoopFillError>,
+) -> Result<(Fill, [f64; 2], f64), LoopFillError> {
+    const BOUNDS: [(f64, f64); 2] = [(0.5, 2.0), (0.0, 4.0)];
+    let mut x = [1.0, 1.0];
+    let (mut best, mut e) = make(x)?;
+    // NaN (a degenerate fill) never wins
+    let better = |a: f64, b: f64| a < b || (b.is_nan() && !a.is_nan());
+    let mut delta = [0.15, 0.4];
+    for _round in 0..2 {
+        for k in [1, 0] {
+            let d = delta[k];
+            let at = |t: f64| -> Result<(f64, Fill), LoopFillError> {
+                let mut y = x;
+                y[k] = t;
+                let (fill, energy) = make(y)?;
+                Ok((energy, fill))
+            };
+            let (lo, hi) = BOUNDS[k];
+            let (xm, xp) = ((x[k] - d).max(lo), (x[k] + d).min(hi));
+            let (em, fm) = at(xm)?;
+            let (ep, fp) = at(xp)?;
+            let mut candidates = vec![(xm, em, fm), (xp, ep, fp)];
+            if let Some(t) = vertex(xm, x[k], xp, em, e, ep) {
+                let t = t.clamp(x[k] - 3.0 * d, x[k] + 3.0 * d).clamp(lo, hi);
+                let (et, ft) = at(t)?;
+                candidates.push((t, et, ft));
+            }
+            for (t, et, ft) in candidates {
+                if better(et, e) {
+                    best = ft;
+                    e = et;
+                    x[k] = t;
+                }
+            }
+        }
+        delta = delta.map(|d| d / 2.0);
+    }
+    Ok((best, x, e))
+}
+
+/// The abscissa of the vertex of the parabola through `(a, fa)`, `(b, fb)`, `(c, fc)`
+/// (`a < b < c`), when it opens upwards.
+fn vertex(a: f64, b: f64, c: f64, fa: f64, fb: f64, fc: f64) -> Option<f64> {
+    let (p, q) = ((b - a) * (fb - fc), (b - c) * (fb - fa));
+    let den = 2.0 * (p - q);
+    if !(a < b && b < c) {
+        return None;
+    }
+    let opens_up = (fb - fa) / (b - a) < (fc - fb) / (c - b);
+    (opens_up && den != 0.0).then(|| b - ((b - a) * p - (b - c) * q) / den)
+}
+
+/// `∫ H² dA` over the patch (`u ∈ [0, 1]`, periodic `v`): `nu`-point Gauss–Legendre in
+/// `u`, the trapezoidal rule (spectrally accurate for periodic integrands) on `nv` points
+/// in `v`, with the exact first and second derivatives. `H = (L G − 2 M F + N E) / 2(EG −
+/// F²)`; points where `X_u × X_v` vanishes (the pole) carry no area.
+pub(crate) fn willmore(x: &dyn Surface, nu: usize, nv: usize) -> f64 {
+    let (us, wu) = crate::solid::gauss_legendre(nu);
+    let vs: Vec<f64> = (0..nv).map(|j| TAU * j as f64 / nv as f64).collect();
+    let g = x.grid2(&us, &vs);
+    let mut sum = 0.0;
+    for (i, w) in wu.iter().enumerate() {
+        for j in 0..nv {
+            let [_, xu, xv, xuu, xuv, xvv] = g[i * nv + j];
+            let n = xu.cross(xv);
+            let a = n.norm();
+            if a == 0.0 {
+                continue;
+            }
+            let n = n / a;
+            let (e, f, gg) = (xu.dot(xu), xu.dot(xv), xv.dot(xv));
+            let (l, m, nn) = (xuu.dot(n), xuv.dot(n), xvv.dot(n));
+            let h = (l * gg - 2.0 * m * f + nn * e) / (2.0 * (e * gg - f * f));
+            sum += w * (TAU / nv as f64) * h * h * a;
+        }
+    }
+    sum
+}
+
+#[cfg(test)]
+mod fairness_tests {
+    use super::vertex;
+
+    /// The vertex of `3 (x − 0.7)² + 2` from three points, on uneven spacing; none for a
+    /// parabola opening downwards or points out of order.
+    #[test]
+    fn parabola_vertex() {
+        let f = |x: f64| 3.0 * (x - 0.7) * (x - 0.7) + 2.0;
+        let (a, b, c) = (0.2, 0.5, 1.3);
+        let v = vertex(a, b, c, f(a), f(b), f(c)).unwrap();
+        // three values of size ~2 and a division by differences of ~1: round-off ~1e-15
+        assert!((v - 0.7).abs() < 1e-14, "{v}");
+        assert_eq!(vertex(a, b, c, -f(a), -f(b), -f(c)), None);
+        assert_eq!(vertex(a, a, c, f(a), f(a), f(c)), None);
     }
 }

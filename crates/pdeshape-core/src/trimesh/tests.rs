@@ -55,8 +55,10 @@ fn sphere_cap_filled() {
         // 0.04 from the sphere's normal where the mesh's tilt 0.025
         assert!(f.seam_dihedral <= 1.4 * p99, "{} > 1.4 × {p99}", f.seam_dihedral);
         assert!(f.edge_ratio.0 > 0.3 && f.edge_ratio.1 < 2.0, "{:?}", f.edge_ratio);
-        // the least-bending fill is flatter than the sphere: its pole lies 5e-3 inside
-        assert!(off < 6e-3, "{off}");
+        // the fairest fill (least Willmore energy; the sphere is a critical point of it)
+        // lies within twice the collar's own fit residual (5.9e-4) of the sphere: 1.1e-3
+        // seen (the fill of fullness and height 1, before the choice, lay 5.7e-3 off)
+        assert!(off < 1.5e-3, "{off}");
     }
 }
 
@@ -160,4 +162,26 @@ fn holes_rims_and_open_ends() {
         assert_eq!(l.kind, LoopKind::OpenEnd);
         assert!(l.facing.abs() < 1e-12, "{}", l.facing);
     }
+}
+
+/// An elliptical hole (semi-axes 0.45 and 0.3) in the saddle `z = 0.3 (x² − ½ y²) +
+/// 0.1 xy` filled at order 6: the fairest fill's vertices lie near the saddle (for a
+/// nearly flat surface the Willmore energy is `¼ ∫ (Δz)²`, whose minimisers include every
+/// quadratic). 1.55e-3 seen, against 9.3e-3 for the fill of fullness and height 1.
+#[test]
+fn saddle_hole_filled_near_the_saddle() {
+    let z = |x: f64, y: f64| 0.3 * (x * x - 0.5 * y * y) + 0.1 * x * y;
+    let mut m = height_grid(80, 0.0, z);
+    let p = m.positions.clone();
+    m.triangles.retain(|t| {
+        let c = t.iter().fold(Vec3::ZERO, |a, &i| a + p[i as usize]) * (1.0 / 3.0);
+        (c.x / 0.45).powi(2) + (c.y / 0.3).powi(2) >= 1.0
+    });
+    let loops = boundary(&m).unwrap();
+    let hole = loops.iter().find(|l| l.kind == LoopKind::Hole).unwrap();
+    let f = fill_loop(&m, hole, m.positions.len() as u32, &LoopFillOptions { order: 6, ..Default::default() }).unwrap();
+    let off = f.positions.iter().fold(0.0, |a: f64, p| max_nan(a, (p.z - z(p.x, p.y)).abs()));
+    eprintln!("off the saddle {off:.2e}; fullness {:.3}, height {:.3}", f.fullness, f.height);
+    assert!(off < 3e-3, "{off}");
+    assert!(f.continuity.g2 < 1e-7, "{}", f.continuity.g2);
 }
