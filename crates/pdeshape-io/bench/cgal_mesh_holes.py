@@ -14,6 +14,10 @@ included); medians of 3.
 
     python crates/pdeshape-io/bench/cgal_mesh_holes.py    # needs `pip install cgal numpy`
                                                             # and a release build
+
+With `--pictures DIR` the holed meshes and both fills are also written to DIR as OBJ and
+drawn in zebra stripes by `pdeshape render`, and (with `pip install pillow`) put side by
+side in DIR/mesh-holes.png: one row per mesh, the holed mesh, CGAL's fill and pdeshape's.
 """
 
 import math
@@ -198,7 +202,44 @@ def measure(v0, f0, v, f, dist):
     return len(new), d.max(), math.sqrt((d * d).mean()), seam, own, n0
 
 
+# camera (azimuth, elevation) looking into each model's first hole
+VIEWS = [(33.7, 68.5), (0.0, 50.0), (35.0, 55.0)]
+
+
+def pictures(out, shots):
+    """Zebra pictures of every (model, method) OBJ in `shots`, and the sheet of them."""
+    rows = []
+    for (az, el), row in zip(VIEWS, shots):
+        pngs = []
+        for label, obj in row:
+            png = obj.with_suffix(".png")
+            subprocess.run([str(EXE), "-q", "render", str(obj), "-o", str(png), "--view", "zebra",
+                            "--stripes", "10", "--width", "420", "--height", "360",
+                            "--azimuth", str(az), "--elevation", str(el)], check=True)
+            pngs.append((label, png))
+        rows.append(pngs)
+    try:
+        from PIL import Image, ImageDraw
+    except ImportError:
+        print("pillow is not installed: the sheet is not made", file=sys.stderr)
+        return
+    w, h, top = 420, 360, 26
+    sheet = Image.new("RGB", (3 * w, len(rows) * (h + top)), "white")
+    draw = ImageDraw.Draw(sheet)
+    for i, row in enumerate(rows):
+        for j, (label, png) in enumerate(row):
+            sheet.paste(Image.open(png).convert("RGB"), (j * w, i * (h + top) + top))
+            draw.text((j * w + 10, i * (h + top) + 6), label, fill="black")
+    sheet.save(out / "mesh-holes.png")
+    print(f"wrote {out / 'mesh-holes.png'}", file=sys.stderr)
+
+
 def main():
+    shots_dir = None
+    if "--pictures" in sys.argv:
+        shots_dir = Path(sys.argv[sys.argv.index("--pictures") + 1])
+        shots_dir.mkdir(parents=True, exist_ok=True)
+    shots = []
     if not EXE.exists():
         sys.exit(f"build {EXE} first: cargo build --release")
     sph_v, sph_f = icosphere(5)
@@ -252,11 +293,22 @@ def main():
             pv, pf = read_obj(pout)
             pd = measure(v, f, pv, pf, dist) + (statistics.median(ptimes),)
             rows.append((name, cg, pd))
+            if shots_dir:
+                k = len(rows)
+                row = []
+                for label, (mv, mf) in ((f"{name}: holed", (v, f)), ("CGAL (fairing)", (cv, cf)),
+                                        ("pdeshape (order 6)", (pv, pf))):
+                    path = shots_dir / f"{k}-{len(row)}.obj"
+                    write_obj(path, mv, mf)
+                    row.append((label, path))
+                shots.append(row)
     print("| mesh | method | new vertices | largest distance | rms distance | seam dihedral (rad) | mesh p99 (rad) | time (s) |")
     print("|---|---|---|---|---|---|---|---|")
     for name, cg, pd in rows:
         for who, r in (("CGAL", cg), ("pdeshape order 6", pd)):
             print(f"| {name} | {who} | {r[0]} | {r[1]:.2e} | {r[2]:.2e} | {r[3]:.3f} | {r[4]:.3f} | {r[6]:.3f} |")
+    if shots_dir:
+        pictures(shots_dir, shots)
 
 
 if __name__ == "__main__":

@@ -137,9 +137,9 @@ enum Command {
         #[arg(long, value_parser = positive)]
         relative_tolerance: Option<f64>,
     },
-    /// Render a scene to PNG.
+    /// Render a scene, or a triangle mesh (.obj, .ply, .stl), to PNG.
     Render {
-        /// Scene file (TOML).
+        /// Scene file (TOML), or a mesh file (shaded, zebra or isophotes).
         scene: PathBuf,
         /// Output PNG.
         #[arg(short, long)]
@@ -427,6 +427,32 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             curvature_limit,
             set,
         } => {
+            if pdeshape_io::import::mesh::MeshFormat::from_path(&scene).is_some() {
+                if !set.is_empty() {
+                    return Err(crate::usage::Usage(format!(
+                        "{}: --set changes a scene's parameters; a mesh file has none",
+                        scene.display()
+                    ))
+                    .into());
+                }
+                let r = pdeshape_io::scene::RenderSettings {
+                    size: (width.unwrap_or(800), height.unwrap_or(600)),
+                    azimuth: azimuth.unwrap_or(35.0),
+                    elevation: elevation.unwrap_or(25.0),
+                    wireframe,
+                    view,
+                    stripes: stripes.unwrap_or(8.0),
+                    stripe_angle: stripe_angle.unwrap_or(0.0),
+                    curvature_limit,
+                    ..Default::default()
+                };
+                let img = crate::holes::render_mesh(&scene, &r, &limits)?;
+                crate::build::write_png(&out, &img)?;
+                if !quiet {
+                    eprintln!("wrote {}", out.display());
+                }
+                return Ok(());
+            }
             let mut sc = loader(&set, None, None).scene(&scene)?;
             if let Some(w) = width {
                 sc.render.size.0 = w;

@@ -184,3 +184,42 @@ fn a_fill_that_would_cross_the_mesh_is_refused() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.exists());
 }
+
+/// `render` draws a mesh file in zebra stripes (a PNG of the size asked); a curvature
+/// view or `--set` on a mesh file is a usage error, nothing written.
+#[test]
+fn render_draws_a_mesh_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.obj");
+    write_obj(&input, &two_holes());
+    let png = dir.path().join("zebra.png");
+    let o = run(&[
+        "render",
+        input.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--view",
+        "zebra",
+        "--width",
+        "120",
+        "--height",
+        "90",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&png).unwrap();
+    // the IHDR chunk: width and height, big-endian, at bytes 16..24
+    assert_eq!(&bytes[1..4], b"PNG");
+    assert_eq!(u32::from_be_bytes(bytes[16..20].try_into().unwrap()), 120);
+    assert_eq!(u32::from_be_bytes(bytes[20..24].try_into().unwrap()), 90);
+    for (args, what) in
+        [(&["--view", "mean"][..], "needs a scene's exact curvature"), (&["--set", "a=1"][..], "a mesh file has none")]
+    {
+        let out = dir.path().join("no.png");
+        let mut a = vec!["render", input.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        a.extend(args);
+        let o = run(&a);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains(what), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(!out.exists());
+    }
+}
