@@ -231,15 +231,22 @@ pub fn vertex_normals(m: &TriMesh) -> Vec<Vec3> {
     n.into_iter().map(|v| v.normalized().unwrap_or(Vec3::ZERO)).collect()
 }
 
-/// `m` as a picture in the view of `r` (shaded, zebra stripes or isophotes: a mesh file
-/// carries no exact curvature), smooth-shaded with [`vertex_normals`].
-pub fn render_trimesh(m: &TriMesh, r: &crate::scene::RenderSettings) -> Result<crate::render::Image, String> {
-    if r.view.curvature().is_some() {
-        return Err(format!(
-            "a mesh file renders shaded, zebra or isophotes: the {} view needs a scene's exact curvature",
-            r.view.name()
-        ));
+/// Whether a mesh file can be drawn in `view`: shaded, zebra stripes or isophotes, not a
+/// curvature map (a mesh file carries no exact curvature).
+pub fn mesh_view(view: crate::render::View) -> Result<(), String> {
+    match view.curvature() {
+        Some(_) => Err(format!(
+            "a mesh file renders shaded, zebra or isophotes; the {} view needs a scene's exact curvature",
+            view.name()
+        )),
+        None => Ok(()),
     }
+}
+
+/// `m` as a picture in the view of `r` ([`mesh_view`]), smooth-shaded with
+/// [`vertex_normals`].
+pub fn render_trimesh(m: &TriMesh, r: &crate::scene::RenderSettings) -> Result<crate::render::Image, String> {
+    mesh_view(r.view)?;
     let mesh = Mesh {
         name: "mesh".into(),
         positions: m.positions.clone(),

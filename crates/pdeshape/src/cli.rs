@@ -427,6 +427,26 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             curvature_limit,
             set,
         } => {
+            // the command line's choices over a scene's picture settings (or the defaults)
+            let apply = |r: &mut pdeshape_io::scene::RenderSettings| {
+                if let Some(w) = width {
+                    r.size.0 = w;
+                }
+                if let Some(h) = height {
+                    r.size.1 = h;
+                }
+                if let Some(a) = azimuth {
+                    r.azimuth = a;
+                }
+                if let Some(e) = elevation {
+                    r.elevation = e;
+                }
+                r.wireframe |= wireframe;
+                r.view = view;
+                r.stripes = stripes.unwrap_or(r.stripes);
+                r.stripe_angle = stripe_angle.unwrap_or(r.stripe_angle);
+                r.curvature_limit = curvature_limit.or(r.curvature_limit);
+            };
             if pdeshape_io::import::mesh::MeshFormat::from_path(&scene).is_some() {
                 if !set.is_empty() {
                     return Err(crate::usage::Usage(format!(
@@ -435,17 +455,8 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                     ))
                     .into());
                 }
-                let r = pdeshape_io::scene::RenderSettings {
-                    size: (width.unwrap_or(800), height.unwrap_or(600)),
-                    azimuth: azimuth.unwrap_or(35.0),
-                    elevation: elevation.unwrap_or(25.0),
-                    wireframe,
-                    view,
-                    stripes: stripes.unwrap_or(8.0),
-                    stripe_angle: stripe_angle.unwrap_or(0.0),
-                    curvature_limit,
-                    ..Default::default()
-                };
+                let mut r = pdeshape_io::scene::RenderSettings::default();
+                apply(&mut r);
                 let img = crate::holes::render_mesh(&scene, &r, &limits)?;
                 crate::build::write_png(&out, &img)?;
                 if !quiet {
@@ -454,23 +465,7 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
                 return Ok(());
             }
             let mut sc = loader(&set, None, None).scene(&scene)?;
-            if let Some(w) = width {
-                sc.render.size.0 = w;
-            }
-            if let Some(h) = height {
-                sc.render.size.1 = h;
-            }
-            if let Some(a) = azimuth {
-                sc.render.azimuth = a;
-            }
-            if let Some(e) = elevation {
-                sc.render.elevation = e;
-            }
-            sc.render.wireframe |= wireframe;
-            sc.render.view = view;
-            sc.render.stripes = stripes.unwrap_or(sc.render.stripes);
-            sc.render.stripe_angle = stripe_angle.unwrap_or(sc.render.stripe_angle);
-            sc.render.curvature_limit = curvature_limit.or(sc.render.curvature_limit);
+            apply(&mut sc.render);
             let img = model::render_scene(&sc).map_err(|e| anyhow!(e))?;
             crate::build::write_png(&out, &img)?;
             if !quiet {

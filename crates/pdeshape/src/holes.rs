@@ -9,7 +9,7 @@ use pdeshape_core::trimesh::{MeshLoop, boundary};
 use pdeshape_io::holes::{FillHolesOptions, fill_holes, holes_report, write_filled};
 use pdeshape_io::import::mesh::{MeshFile, MeshFormat, read_mesh};
 use pdeshape_io::import::step::{StepModel, read_step};
-use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, render_trimesh, write_trimesh};
+use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, mesh_view, render_trimesh, write_trimesh};
 use std::path::Path;
 
 fn is_step(p: &Path) -> bool {
@@ -217,14 +217,8 @@ pub fn render_mesh(
     r: &pdeshape_io::scene::RenderSettings,
     limits: &Limits,
 ) -> Result<pdeshape_io::render::Image> {
-    if r.view.curvature().is_some() {
-        return Err(Usage(format!(
-            "{}: a mesh file renders shaded, zebra or isophotes; the {} view needs a scene's exact curvature",
-            path.display(),
-            r.view.name()
-        ))
-        .into());
-    }
+    // a usage error, before the file is read
+    mesh_view(r.view).map_err(|e| Usage(format!("{}: {e}", path.display())))?;
     let mf = read_mesh(path, limits)?;
     render_trimesh(&mf.mesh, r).map_err(|e| anyhow!("{}: {e}", mf.file))
 }

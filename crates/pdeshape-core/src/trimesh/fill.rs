@@ -481,11 +481,11 @@ fn fairest(
 /// The abscissa of the vertex of the parabola through `(a, fa)`, `(b, fb)`, `(c, fc)`
 /// (`a < b < c`), when it opens upwards.
 fn vertex(a: f64, b: f64, c: f64, fa: f64, fb: f64, fc: f64) -> Option<f64> {
-    let (p, q) = ((b - a) * (fb - fc), (b - c) * (fb - fa));
-    let den = 2.0 * (p - q);
     if !(a < b && b < c) {
         return None;
     }
+    let (p, q) = ((b - a) * (fb - fc), (b - c) * (fb - fa));
+    let den = 2.0 * (p - q);
     let opens_up = (fb - fa) / (b - a) < (fc - fb) / (c - b);
     (opens_up && den != 0.0).then(|| b - ((b - a) * p - (b - c) * q) / den)
 }
@@ -494,7 +494,7 @@ fn vertex(a: f64, b: f64, c: f64, fa: f64, fb: f64, fc: f64) -> Option<f64> {
 /// `u`, the trapezoidal rule (spectrally accurate for periodic integrands) on `nv` points
 /// in `v`, with the exact first and second derivatives. `H = (L G − 2 M F + N E) / 2(EG −
 /// F²)`; points where `X_u × X_v` vanishes (the pole) carry no area.
-pub(crate) fn willmore(x: &dyn Surface, nu: usize, nv: usize) -> f64 {
+fn willmore(x: &dyn Surface, nu: usize, nv: usize) -> f64 {
     let (us, wu) = crate::solid::gauss_legendre(nu);
     let vs: Vec<f64> = (0..nv).map(|j| TAU * j as f64 / nv as f64).collect();
     let g = x.grid2(&us, &vs);
