@@ -102,7 +102,55 @@ impl Tape {
             let r = c.node(e);
             c.tape.outputs.push(r);
         }
-        c.tape
+        c.tape.without_dead_code()
+    }
+
+    /// The tape without the instructions no output reads (the branches a constant
+    /// `select` dropped, the operands of folded constants), registers renumbered in order.
+    fn without_dead_code(self) -> Tape {
+        let mut live = vec![false; self.ops.len()];
+        for &o in &self.outputs {
+            live[o as usize] = true;
+        }
+        for i in (0..self.ops.len()).rev() {
+            if !live[i] {
+                continue;
+            }
+            let mut mark = |r: u32| live[r as usize] = true;
+            match self.ops[i] {
+                Op::Num(_) | Op::Var(_) => {}
+                Op::Neg(a) | Op::MulC(a, _) | Op::DivC(a, _) | Op::PowC(a, _) | Op::Call1(_, a) => mark(a),
+                Op::Bin(_, a, b) | Op::Call2(_, a, b) => {
+                    mark(a);
+                    mark(b)
+                }
+                Op::Select(x, a, b) => {
+                    mark(x);
+                    mark(a);
+                    mark(b)
+                }
+            }
+        }
+        let mut new = vec![u32::MAX; self.ops.len()];
+        let mut ops = Vec::with_capacity(self.ops.len());
+        for (i, op) in self.ops.iter().enumerate().filter(|(i, _)| live[*i]) {
+            let m = |r: u32| new[r as usize];
+            ops.push(match *op {
+                Op::Num(x) => Op::Num(x),
+                Op::Var(v) => Op::Var(v),
+                Op::Neg(a) => Op::Neg(m(a)),
+                Op::Bin(o, a, b) => Op::Bin(o, m(a), m(b)),
+                Op::MulC(a, c) => Op::MulC(m(a), c),
+                Op::DivC(a, c) => Op::DivC(m(a), c),
+                Op::PowC(a, c) => Op::PowC(m(a), c),
+                Op::Call1(f, a) => Op::Call1(f, m(a)),
+                Op::Call2(f, a, b) => Op::Call2(f, m(a), m(b)),
+                Op::Select(x, a, b) => Op::Select(m(x), m(a), m(b)),
+            });
+            new[i] = (ops.len() - 1) as u32;
+        }
+        let outputs = self.outputs.iter().map(|&o| new[o as usize]).collect();
+        Tape { ops, outputs, vars: self.vars }
     }
 
     /// Number of instructions.
@@ -186,8 +234,49 @@ impl Compiler {
         })
     }
 
+    /// The number register `r` holds when it is a constant.
+    fn constant(&self, r: u32) -> Option<f64> {
+        match self.tape.ops[r as usize] {
+            Op::Num(x) => Some(x),
+            _ => None,
+        }
+    }
+
+    /// `op` evaluated now when every operand is a constant: the same `f64` operation the
+    /// tape would run (so `f64` results do not change), its derivatives zero. `None` when
+    /// an operand varies (`select` is decided elsewhere).
+    fn fold(&self, op: &Op) -> Option<f64> {
+        let c = |r: u32| self.constant(r);
+        Some(match *op {
+            Op::Neg(a) => c(a)?.neg(),
+            Op::Bin(o, a, b) => c(a)?.bin(o, &c(b)?),
+            Op::MulC(a, k) => c(a)?.mul_c(k),
+            Op::DivC(a, k) => c(a)?.div_c(k),
+            Op::PowC(a, k) => c(a)?.pow_c(k),
+            Op::Call1(f, a) => c(a)?.call1(f),
+            Op::Call2(f, a, b) => c(a)?.call2(f, &c(b)?),
+            Op::Num(_) | Op::Var(_) | Op::Select(..) => return None,
+        })
+    }
+
     fn node(&mut self, e: &Expr) -> u32 {
-        let op = match &e.node {
+        let op = self.op(e);
+        // a `select` whose condition is a constant is the branch it picks; other
+        // operations on constants are constants (`4*(1 - cos(s)/2)` for a section's bound
+        // `s` costs nothing per point)
+        if let Op::Select(x, a, b) = op
+            && let Some(v) = self.constant(x)
+        {
+            return if v > 0.0 { a } else { b };
+        }
+        match self.fold(&op) {
+            Some(v) => self.push(Op::Num(v)),
+            None => self.push(op),
+        }
+    }
+
+    fn op(&mut self, e: &Expr) -> Op {
+        match &e.node {
             Node::Num(x) => Op::Num(*x),
             Node::Var(i) => {
                 self.tape.vars = self.tape.vars.max(i + 1);
@@ -215,8 +304,7 @@ impl Compiler {
                 }
             }
             Node::Ident(n) => panic!("unbound identifier `{n}` compiled"),
-        };
-        self.push(op)
+        }
     }
 }
 
@@ -373,6 +461,44 @@ mod tests {
     use proptest::prelude::*;
 
     const VARS: [&str; 2] = ["v", "t"];
+
+    /// Operations on constants are done when compiling, a `select` on a constant keeps
+    /// only its branch, and nothing dead stays: the Klein bottle's section at a bound `s`
+    /// keeps `cos(v)` and `cos(v + π)` behind a constant factor — and the values are those
+    /// of the expression, bit for bit, values and derivatives.
+    #[test]
+    fn constants_are_folded_and_dead_branches_dropped() {
+        let src = "1.3*cos(s)*(1 + sin(s)) + 4*(1 - cos(s)/2)*select(pi - s, cos(s)*cos(v), cos(v + pi))";
+        // s < π: [c₀, v, cos v, ·cos s, ·c₁, +]; s > π: [c₀, v, π, v + π, cos, ·c₁, +]
+        for (s, ops) in [(0.5, 6), (4.0, 7)] {
+            let e = Expr::parse(src).unwrap().bind(&VARS, &|p| (p == "s").then_some(s)).unwrap();
+            let tape = Tape::compile(&[&e]);
+            // no trig of s, no other branch
+            let trig = tape.ops.iter().filter(|o| matches!(o, Op::Call1(..))).count();
+            assert_eq!(trig, 1, "s = {s}: {:?}", tape.ops);
+            assert_eq!(tape.len(), ops, "s = {s}: {:?}", tape.ops);
+            let mut regs = Vec::new();
+            for k in 0..50 {
+                let v = -3.0 + 0.13 * k as f64;
+                assert_eq!(tape.eval(&[v, 0.0], &0.0, &mut regs)[0].to_bits(), e.eval(&[v, 0.0]).to_bits());
+                // the derivative against the hand-derived one (s < π: c₁ cos(s) cos v,
+                // s > π: c₁ cos(v + π); c₁ = 4(1 − cos(s)/2))
+                let d = tape.eval(
+                    &[Taylor::<2>::variable(v), Taylor::constant(0.0)],
+                    &Taylor::constant(0.0),
+                    &mut Vec::new(),
+                )[0]
+                .derivative(1);
+                let c1 = 4.0 * (1.0 - s.cos() / 2.0);
+                let want = if s < std::f64::consts::PI {
+                    -c1 * s.cos() * v.sin()
+                } else {
+                    -c1 * (v + std::f64::consts::PI).sin()
+                };
+                assert!((d - want).abs() < 1e-14, "s = {s}, v = {v}: {d} vs {want}");
+            }
+        }
+    }
 
     fn bound(src: &str) -> Expr {
         Expr::parse(src).unwrap().bind(&VARS, &|p| (p == "a").then_some(1.7)).unwrap()
