@@ -68,6 +68,23 @@ impl ExprField {
             *d = Vec3::new(o[0].derivative(k), o[1].derivative(k), o[2].derivative(k));
         }
     }
+
+    /// [`taylor`](Self::taylor) at many points (`stride` slots each, `k` outputs each) with
+    /// one workspace: the same operations per point.
+    fn taylor_many<const N: usize>(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
+        let nv = self.vars.len();
+        let mut vars = vec![Taylor::<N>::constant(0.0); nv];
+        let mut regs = Vec::new();
+        for (p, dst) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
+            for (i, x) in vars.iter_mut().enumerate() {
+                *x = if i == slot { Taylor::variable(p[i]) } else { Taylor::constant(p[i]) };
+            }
+            let o = self.tape.eval(&vars, &Taylor::constant(0.0), &mut regs);
+            for (k, d) in dst.iter_mut().enumerate() {
+                *d = Vec3::new(o[0].derivative(k), o[1].derivative(k), o[2].derivative(k));
+            }
+        }
+    }
 }
 
 impl Field for ExprField {
@@ -101,6 +118,29 @@ impl Field for ExprField {
             4 => self.taylor::<4>(at, slot, out),
             5..=8 => self.taylor::<8>(at, slot, out),
             _ => super::derivatives_by_jet(self, at, slot, out),
+        }
+    }
+
+    fn derivatives_in_many(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
+        match k {
+            0 => {}
+            1 => {
+                let nv = self.vars.len();
+                let mut regs = Vec::new();
+                for (p, dst) in at.chunks_exact(stride).zip(out.iter_mut()) {
+                    let o = self.tape.eval(&p[..nv], &0.0, &mut regs);
+                    *dst = Vec3::new(o[0], o[1], o[2]);
+                }
+            }
+            2 => self.taylor_many::<2>(at, stride, slot, k, out),
+            3 => self.taylor_many::<3>(at, stride, slot, k, out),
+            4 => self.taylor_many::<4>(at, stride, slot, k, out),
+            5..=8 => self.taylor_many::<8>(at, stride, slot, k, out),
+            _ => {
+                for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
+                    super::derivatives_by_jet(self, p, slot, o);
+                }
+            }
         }
     }
 

@@ -63,6 +63,28 @@ impl Field for EvenExtension {
             }
         }
     }
+    /// Every point mapped, the inner field's batch, then `(dv/dθ)ᵏ` in slot 0: the
+    /// numbers of [`derivatives_in`](Field::derivatives_in) per point.
+    fn derivatives_in_many(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
+        let mut mapped = at.to_vec();
+        let mut dvs = Vec::with_capacity(at.len() / stride.max(1));
+        for p in mapped.chunks_exact_mut(stride) {
+            let (v, dv) = self.map(p[0]);
+            p[0] = v;
+            dvs.push(dv);
+        }
+        self.inner.derivatives_in_many(&mapped, stride, slot, k, out);
+        if slot == 0 && k > 0 {
+            for (o, dv) in out.chunks_exact_mut(k).zip(dvs) {
+                let mut f = 1.0;
+                for x in o {
+                    *x *= f;
+                    f *= dv;
+                }
+            }
+        }
+    }
+
     fn is_constant_in(&self, slot: usize) -> bool {
         self.inner.is_constant_in(slot)
     }

@@ -97,6 +97,19 @@ pub trait Field: Send + Sync + Debug {
         derivatives_by_jet(self, at, slot, out)
     }
 
+    /// [`derivatives_in`](Self::derivatives_in) at many points: point `p` is
+    /// `at[p·stride ..][..stride]` and its `k` derivatives go to `out[p·k ..][..k]`. The
+    /// same numbers as one call per point; fields override it to share work between the
+    /// points (expression fields keep one tape workspace for the batch).
+    fn derivatives_in_many(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
+        if k == 0 {
+            return;
+        }
+        for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
+            self.derivatives_in(p, slot, o);
+        }
+    }
+
     /// True when the field does not depend on slot `slot` (e.g. time for a B-spline).
     fn is_constant_in(&self, _slot: usize) -> bool {
         false
