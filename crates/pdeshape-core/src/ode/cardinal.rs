@@ -131,6 +131,12 @@ impl Cardinal {
         &self.space
     }
 
+    /// `C`: column `i` holds the coefficients of `ℓ_i` in the space's basis
+    /// ([`ExpSpace::derivatives`]' order), `ℓ_i = Σ_b φ_b C_{bi}`.
+    pub fn coefficients(&self) -> &Mat<f64> {
+        &self.coef
+    }
+
     /// The Lebesgue constant `max_u Σ_i |ℓ_i(u)|` estimated on `samples` equispaced points
     /// (and the condition points): the factor by which the data can be amplified between
     /// the conditions.

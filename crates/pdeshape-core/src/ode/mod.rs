@@ -25,8 +25,12 @@
 //!   well-conditioned ultraspherical system, in f64, where the exponential basis is
 //!   ill-conditioned; [`ChebCardinal`] does it in multiple precision, the last resort;
 //!   [`CardinalSet`] picks the first that is accurate.
+//! - [`Combined`] holds fixed linear combinations of a set's cardinal functions in the
+//!   set's own basis, evaluated at any `u` without allocating (a spectral patch's modes at
+//!   scattered points).
 
 mod cardinal;
+mod combined;
 mod poly;
 mod precise;
 mod set;
@@ -34,6 +38,7 @@ mod space;
 mod ultraspherical;
 
 pub use cardinal::{Cardinal, CondSpec, OdeError};
+pub use combined::{Combined, chebyshev_t};
 pub use poly::{CLUSTER_TOL, PolyRoots, polynomial_from_roots, polynomial_roots};
 pub use precise::ChebCardinal;
 pub use set::{CardinalSet, F64_COND_LIMIT};

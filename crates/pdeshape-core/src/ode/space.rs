@@ -167,6 +167,11 @@ impl ExpSpace {
         &self.roots
     }
 
+    /// True when some distinct roots share a divided-difference basis.
+    pub fn clustered(&self) -> bool {
+        self.clusters.iter().any(|c| c.len() > 1)
+    }
+
     /// `out[j][b] = φ_b^{(j)}(u)` for `j = 0 … kmax` and every basis function `b`.
     pub fn derivatives(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
         let mut out = vec![Vec::with_capacity(self.dim); kmax + 1];

@@ -284,6 +284,17 @@ impl UltraCardinal {
         self.kmax
     }
 
+    /// The Chebyshev series (in `x = 2u − 1`) of every `ℓ_i^{(k)}`, `k ≤ kmax`: what
+    /// [`eval`](Self::eval) sums away from the condition points.
+    pub fn series(&self, k: usize) -> &[Vec<f64>] {
+        &self.coef[k]
+    }
+
+    /// The points where [`eval`](Self::eval) answers from the system's own rows.
+    pub fn stored_points(&self) -> Vec<f64> {
+        self.at_conditions.iter().map(|(u, _)| *u).collect()
+    }
+
     /// Condition number `‖A‖₁‖A⁻¹‖₁` of the row-scaled system (`‖A⁻¹‖₁` estimated, a lower
     /// bound within a factor of about 3: [`crate::linalg::inverse_norm1_estimate`]).
     pub fn condition_number(&self) -> f64 {
