@@ -72,6 +72,26 @@ pub trait Surface: Send + Sync {
         self.derivatives(u, v, 0, 0)[0]
     }
 
+    /// `out[p] = X(u, v)` at scattered parameters `uv[p] = [u, v]`, on the calling thread.
+    /// Kinds override it to share work between the points (no per-point cache, lock or
+    /// allocation); the result equals [`point`](Self::point)'s to round-off.
+    fn points_at(&self, uv: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(uv.len(), out.len(), "one output per point");
+        for (o, p) in out.iter_mut().zip(uv) {
+            *o = self.point(p[0], p[1]);
+        }
+    }
+
+    /// `out[p] = [X, X_u, X_v]` at scattered parameters `uv[p] = [u, v]`, on the calling
+    /// thread; as [`points_at`](Self::points_at), with first derivatives.
+    fn firsts_at(&self, uv: &[[f64; 2]], out: &mut [[Vec3; 3]]) {
+        assert_eq!(uv.len(), out.len(), "one output per point");
+        for (o, p) in out.iter_mut().zip(uv) {
+            let d = self.derivatives(p[0], p[1], 1, 1);
+            *o = [d[0], d[2], d[1]];
+        }
+    }
+
     /// Values and first derivatives `[X, X_u, X_v, X_uv]` on the grid `us × vs` (row-major
     /// in `u`). Solvers override this to share per-row and per-column work.
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {

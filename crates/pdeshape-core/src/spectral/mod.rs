@@ -100,6 +100,8 @@ pub struct SpectralPatch {
     deep: OnceLock<Option<CardSets>>,
     time: f64,
     cache: BoundedMemo<(u64, usize), Arc<Row>>,
+    /// The modes folded for scattered points ([`batch`]), on first use.
+    folded: OnceLock<batch::Folded>,
 }
 
 /// The modes' cardinal sets and the remainder's.
@@ -258,6 +260,7 @@ impl SpectralPatch {
             deep: OnceLock::new(),
             time: 0.0,
             cache: BoundedMemo::new(4096),
+            folded: OnceLock::new(),
         })
     }
 
@@ -470,6 +473,18 @@ impl Surface for SpectralPatch {
         out
     }
 
+    fn points_at(&self, uv: &[[f64; 2]], out: &mut [Vec3]) {
+        let mut o = vec![[Vec3::ZERO]; uv.len()];
+        self.scattered(uv, [(0, 0)], &mut o);
+        for (d, s) in out.iter_mut().zip(o) {
+            *d = s[0];
+        }
+    }
+
+    fn firsts_at(&self, uv: &[[f64; 2]], out: &mut [[Vec3; 3]]) {
+        self.scattered(uv, [(0, 0), (1, 0), (0, 1)], out);
+    }
+
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
         self.grid_products(us, vs, [(0, 0), (1, 0), (0, 1), (1, 1)])
     }
@@ -606,5 +621,6 @@ impl SpectralPatch {
     }
 }
 
+mod batch;
 #[cfg(test)]
 mod tests;
