@@ -36,22 +36,37 @@ impl<'a> Target<'a> {
 /// Points at or above this count are spread over the current rayon pool.
 pub const PARALLEL_FROM: usize = 4096;
 
+/// Surface points per batch ([`Surface::points_at`]); blocks of this many go to the
+/// rayon pool at or above [`PARALLEL_FROM`] points.
+const BLOCK: usize = 1024;
+
 /// `out[3k..3k+3]` = the point at parameters `params[a·k .. a·k + a]` (`a` =
-/// [`Target::arity`]), computed by the same calls as `pdeshape sample`, so the results are
-/// equal bit for bit. Ranges are the caller's to check.
+/// [`Target::arity`]), computed by the same calls as `pdeshape sample` (a surface's
+/// points in batches through [`Surface::points_at`], whose numbers do not depend on how
+/// the points are grouped), so the results are equal bit for bit. Ranges are the
+/// caller's to check.
 pub fn points_into(target: Target<'_>, params: &[f64], out: &mut [f64]) {
     let a = target.arity();
     assert_eq!(params.len() / a * 3, out.len(), "three outputs per point");
-    let one = |(dst, p): (&mut [f64], &[f64])| {
-        let x = match target {
-            Target::Surface(s) => s.point(p[0], p[1]),
-            Target::Solid(b) => b.point(p[0], p[1], p[2]),
-        };
-        dst.copy_from_slice(&[x.x, x.y, x.z]);
+    let block = |(dst, p): (&mut [f64], &[f64])| match target {
+        Target::Surface(s) => {
+            let uv: Vec<[f64; 2]> = p.chunks_exact(2).map(|q| [q[0], q[1]]).collect();
+            let mut x = vec![pdeshape_core::Vec3::ZERO; uv.len()];
+            s.points_at(&uv, &mut x);
+            for (d, x) in dst.chunks_exact_mut(3).zip(x) {
+                d.copy_from_slice(&[x.x, x.y, x.z]);
+            }
+        }
+        Target::Solid(b) => {
+            for (d, q) in dst.chunks_exact_mut(3).zip(p.chunks_exact(3)) {
+                let x = b.point(q[0], q[1], q[2]);
+                d.copy_from_slice(&[x.x, x.y, x.z]);
+            }
+        }
     };
     if out.len() / 3 >= PARALLEL_FROM {
-        out.par_chunks_mut(3).zip(params.par_chunks(a)).for_each(one);
+        out.par_chunks_mut(3 * BLOCK).zip(params.par_chunks(a * BLOCK)).for_each(block);
     } else {
-        out.chunks_mut(3).zip(params.chunks(a)).for_each(one);
+        out.chunks_mut(3 * BLOCK).zip(params.chunks(a * BLOCK)).for_each(block);
     }
 }

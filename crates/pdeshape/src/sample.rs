@@ -49,18 +49,43 @@ pub fn command(sc: &Scene, patch: Option<&str>, time: Option<f64>, quiet: bool) 
     }
 }
 
+/// Rows handed to the writer at once (the patch is evaluated a block at a time).
+const BLOCK: usize = 1024;
+
 /// Reads CSV rows of `N` finite numbers from stdin and writes `header` then one line per
-/// row from `f`; errors name the line. Blank lines and `#` comments are skipped, and so is
+/// row from `f`, which gets the rows in blocks of up to [`BLOCK`] with their line numbers
+/// (the rows before a bad line are written before its error); errors name the line. Blank lines and `#` comments are skipped, and so is
 /// a first line that is literally the column names (`u,v` or `u,v,w`, spaces allowed); a
 /// UTF-8 byte-order mark is dropped. Any other line that is not `N` numbers is an error.
 fn sample_rows<const N: usize>(
     header: &str,
-    mut f: impl FnMut(usize, [f64; N], &mut dyn Write) -> Result<()>,
+    mut f: impl FnMut(&[(usize, [f64; N])], &mut dyn Write) -> Result<()>,
+) -> Result<()> {
+    let mut block: Vec<(usize, [f64; N])> = Vec::with_capacity(BLOCK);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let read = read_rows(header, &mut out, |row, out| {
+        block.push(row);
+        if block.len() == BLOCK {
+            f(&block, out)?;
+            block.clear();
+        }
+        Ok(())
+    });
+    // the rows read before an error are written, then the error
+    f(&block, &mut out)?;
+    read?;
+    out.flush()?;
+    Ok(())
+}
+
+/// The reading half of [`sample_rows`]: each valid row to `f`.
+fn read_rows<const N: usize>(
+    header: &str,
+    out: &mut dyn Write,
+    mut f: impl FnMut((usize, [f64; N]), &mut dyn Write) -> Result<()>,
 ) -> Result<()> {
     let names = header.split(',').take(N).collect::<Vec<_>>().join(",");
     let stdin = std::io::stdin();
-    let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::new(stdout.lock());
     writeln!(out, "{header}")?;
     let mut first = true;
     for (ln, line) in stdin.lock().lines().enumerate() {
@@ -83,25 +108,26 @@ fn sample_rows<const N: usize>(
                 bail!("stdin line {}: `{c}` is not finite", ln + 1);
             }
         }
-        f(ln + 1, vals, &mut out)?;
+        f((ln + 1, vals), out)?;
     }
-    out.flush()?;
     Ok(())
 }
 
 /// `u,v,w` from stdin to `u,v,w,x,y,z` for a solid blend.
 fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
-    sample_rows("u,v,w,x,y,z", |ln, [u, v, w], out| {
-        for (name, x) in [("u", u), ("v", v), ("w", w)] {
-            if !(0.0..=1.0).contains(&x) {
-                bail!("stdin line {ln}: {name} = {x} is outside [0, 1]");
+    sample_rows("u,v,w,x,y,z", |rows, out| {
+        for &(ln, [u, v, w]) in rows {
+            for (name, x) in [("u", u), ("v", v), ("w", w)] {
+                if !(0.0..=1.0).contains(&x) {
+                    bail!("stdin line {ln}: {name} = {x} is outside [0, 1]");
+                }
             }
+            let x = s.point(u, v, w);
+            if !x.is_finite() {
+                bail!("stdin line {ln}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})");
+            }
+            writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
         }
-        let x = s.point(u, v, w);
-        if !x.is_finite() {
-            bail!("stdin line {ln}: the solid is not finite at (u, v, w) = ({u}, {v}, {w})");
-        }
-        writeln!(out, "{u:.17e},{v:.17e},{w:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
         Ok(())
     })
 }
@@ -109,18 +135,29 @@ fn sample_solid(s: &pdeshape_core::solid::SolidBlend) -> Result<()> {
 /// `u,v` from stdin to `u,v,x,y,z` for a patch.
 fn sample(surface: &dyn pdeshape_core::patch::Surface) -> Result<()> {
     let dom = surface.v_domain();
-    sample_rows("u,v,x,y,z", |ln, [u, v], out| {
-        if !(0.0..=1.0).contains(&u) {
-            bail!("stdin line {ln}: u = {u} is outside [0, 1]");
+    let mut pts = Vec::with_capacity(BLOCK);
+    sample_rows("u,v,x,y,z", |rows, out| {
+        // the rows up to the first out of range are evaluated in one batch (the call
+        // `Patch.evaluate` makes, so the numbers are the same bit for bit)
+        let bad = rows.iter().position(|&(_, [u, v])| {
+            !(0.0..=1.0).contains(&u) || (!dom.periodic && !(dom.start..=dom.end).contains(&v))
+        });
+        let good = &rows[..bad.unwrap_or(rows.len())];
+        let uv: Vec<[f64; 2]> = good.iter().map(|r| r.1).collect();
+        pts.resize(uv.len(), pdeshape_core::Vec3::ZERO);
+        surface.points_at(&uv, &mut pts);
+        for (&(ln, [u, v]), x) in good.iter().zip(&pts) {
+            if !x.is_finite() {
+                bail!("stdin line {ln}: the patch is not finite at (u, v) = ({u}, {v})");
+            }
+            writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
         }
-        if !dom.periodic && !(dom.start..=dom.end).contains(&v) {
+        if let Some(&(ln, [u, v])) = bad.map(|k| &rows[k]) {
+            if !(0.0..=1.0).contains(&u) {
+                bail!("stdin line {ln}: u = {u} is outside [0, 1]");
+            }
             bail!("stdin line {ln}: v = {v} is outside [{}, {}]", dom.start, dom.end);
         }
-        let x = surface.point(u, v);
-        if !x.is_finite() {
-            bail!("stdin line {ln}: the patch is not finite at (u, v) = ({u}, {v})");
-        }
-        writeln!(out, "{u:.17e},{v:.17e},{:.17e},{:.17e},{:.17e}", x.x, x.y, x.z)?;
         Ok(())
     })
 }
