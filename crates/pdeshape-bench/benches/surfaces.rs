@@ -215,6 +215,52 @@ fn evaluate_million(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 31: 10⁵ scattered points (the low-discrepancy points of the Python bench) on the
+/// Klein bottle and the Bloor–Wilson blend, pointwise (`Surface::point`, `derivatives`:
+/// per-row caches) and batched (`Surface::points_at`, `firsts_at`), on the calling thread.
+/// The patch is solved once; its folded modes are built on the first batched call, as
+/// part of the solved patch, and kept (the pointwise row cache is emptied every
+/// iteration).
+fn scattered(c: &mut Criterion) {
+    use pdeshape_core::Vec3;
+    let mut g = c.benchmark_group("scattered points (10^5)");
+    g.sample_size(10);
+    let n = 100_000;
+    let (g1, g2) = (0.7548776662466927, 0.5698402909980532);
+    for name in ["klein-bottle", "bloor-wilson-blend"] {
+        let sc = load(&format!("{name}.toml"));
+        let s = sc.patches[0].surface.clone();
+        let dom = s.v_domain();
+        let uv: Vec<[f64; 2]> = (0..n).map(|k| [(k as f64 * g1).fract(), dom.at((k as f64 * g2).fract())]).collect();
+        let clear = || {
+            if let Some(p) = &sc.patches[0].spectral {
+                p.clear_row_cache()
+            }
+        };
+        g.bench_function(format!("{name}: values, pointwise"), |b| {
+            b.iter(|| {
+                clear();
+                uv.iter().map(|p| s.point(p[0], p[1]).x).sum::<f64>()
+            })
+        });
+        g.bench_function(format!("{name}: values, batched"), |b| {
+            let mut out = vec![Vec3::ZERO; n];
+            b.iter(|| s.points_at(&uv, &mut out))
+        });
+        g.bench_function(format!("{name}: with first derivatives, pointwise"), |b| {
+            b.iter(|| {
+                clear();
+                uv.iter().map(|p| s.derivatives(p[0], p[1], 1, 1)[1].x).sum::<f64>()
+            })
+        });
+        g.bench_function(format!("{name}: with first derivatives, batched"), |b| {
+            let mut out = vec![[Vec3::ZERO; 3]; n];
+            b.iter(|| s.firsts_at(&uv, &mut out))
+        });
+    }
+    g.finish();
+}
+
 /// Issue 18: measured B-spline fitting of a scene's faces (solved patches given; the fit
 /// keeps nothing between iterations), at the default tolerance (1e-6 × each face's
 /// bounding-box diagonal) and at 1e-8 ×.
@@ -234,6 +280,6 @@ criterion_group! {
     name = benches;
     // no plots: criterion's plot backend needs system fonts
     config = Criterion::default().without_plots();
-    targets = surfaces, evaluate_million, cad_fit
+    targets = surfaces, evaluate_million, scattered, cad_fit
 }
 criterion_main!(benches);
