@@ -68,8 +68,16 @@ impl Field for Trimline {
             self.surface.derivatives_in(&on_surface, slot + 1, out);
         } else if out.len() == 1 {
             // the value of the d-th cross derivative: along s at fixed (v, t)
-            let mut along_s = vec![Vec3::ZERO; d + 1];
-            self.surface.derivatives_in(&on_surface, 0, &mut along_s);
+            // on the stack for the orders conditions take (a point of a blend's data)
+            let mut stack = [Vec3::ZERO; 9];
+            let mut heap = Vec::new();
+            let along_s: &mut [Vec3] = if d < stack.len() {
+                &mut stack[..=d]
+            } else {
+                heap.resize(d + 1, Vec3::ZERO);
+                &mut heap
+            };
+            self.surface.derivatives_in(&on_surface, 0, along_s);
             out[0] = along_s[d] * self.scale.powi(d as i32);
         } else {
             super::derivatives_by_jet(self, at, slot, out);
