@@ -7,7 +7,7 @@
 //! buffer numpy takes over (no copy), meshes are copied once out of the core's `Vec3`s.
 
 use numpy::ndarray::{Array1, Array2, Array4, ArrayView2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pdeshape_core::Vec3;
 use pdeshape_core::limits::{Cap, Limits};
 use pdeshape_core::mesh::Mesh as CoreMesh;
@@ -20,9 +20,12 @@ use pyo3::exceptions::{
     PyException, PyKeyError, PyMemoryError, PyRuntimeError, PyTimeoutError, PyTypeError, PyValueError,
 };
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict, PyTuple};
 use std::borrow::Cow;
 use std::sync::Arc;
+
+mod pool;
+mod toml_text;
 
 /// The allocator of the `pdeshape` binary (for the Rust side's allocations only), so that
 /// evaluations cost what they cost there.
@@ -91,7 +94,7 @@ const DEFAULT_TIME_LIMIT: f64 = 600.0;
 /// computation stops at its next checkpoint and `TimeoutError` is raised.
 fn limited<T: Send>(py: Python<'_>, seconds: f64, what: &str, f: impl FnOnce() -> T + Send) -> PyResult<T> {
     if seconds <= 0.0 {
-        return Ok(py.detach(f));
+        return Ok(pool::detached(py, f));
     }
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     py.detach(|| pdeshape_core::cancel::within(std::time::Duration::from_secs_f64(seconds), threads, f)).map_err(|_| {
@@ -160,6 +163,66 @@ impl Scene {
 
 #[pymethods]
 impl Scene {
+    /// A scene built from Python values in the scene file's vocabulary: each keyword is a
+    /// top-level table of a scene file (`scene`, `parameters`, `curves`, `surfaces`,
+    /// `patches`, `render`, `output`, `studies`) given as dicts, lists, numbers, strings
+    /// and numpy arrays; `Scene(**tomllib.load(f))` is the scene of file `f`.
+    ///
+    /// >>> ring = numpy.array([[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], float)
+    /// >>> pdeshape.Scene(
+    /// ...     curves={"bottom": pdeshape.bspline(ring, closed=True),
+    /// ...             "top": pdeshape.bspline(ring + [0, 0, 1], closed=True)},
+    /// ...     patches={"tube": pdeshape.pde(conditions=[{"u": 0, "curve": "bottom"},
+    /// ...                                               {"u": 1, "curve": "top"}])})
+    ///
+    /// The values are written as scene text (`to_toml` returns it) and that text is parsed
+    /// and solved, so the scene equals the one its text describes bit for bit. Errors name
+    /// the argument and the index (`curves.top.bspline[2][0] = nan is not finite`) or, for
+    /// what the scene itself rejects, the key (`SceneError.key`). `name`, `solver`,
+    /// `terms`, `limits` and `time_limit` are as in `from_toml`.
+    #[new]
+    #[pyo3(signature = (*, name="scene", solver=None, terms=None, limits=None, time_limit=None, **tables))]
+    fn new(
+        py: Python<'_>,
+        name: &str,
+        solver: Option<String>,
+        terms: Option<usize>,
+        limits: Option<&Bound<'_, PyDict>>,
+        time_limit: Option<f64>,
+        tables: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Scene> {
+        let text = match tables {
+            Some(t) => toml_text::scene_text(t)?,
+            None => String::new(),
+        };
+        Scene::from_toml(py, &text, name, solver, terms, limits, time_limit, None)
+    }
+
+    /// The scene text this scene was solved from, with the values given to `set` (or as
+    /// keywords of `load`) written into its `[parameters]`: `Scene.from_toml(s.to_toml())`
+    /// is `s` bit for bit. `solver`, `terms`, `limits` and `time_limit` are options of the
+    /// load, not part of the text.
+    fn to_toml(&self) -> PyResult<String> {
+        pdeshape_io::scene::edit::with_parameters(&self.inner.source, &self.inner.options.params)
+            .map_err(PyRuntimeError::new_err)
+    }
+
+    /// Pickling: the scene's text, name and load options; unpickling solves it again
+    /// (deterministic: the same arrays bit for bit), so scenes go to `multiprocessing`,
+    /// `concurrent.futures`, Dask and Ray workers.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let restore = py.import("pdeshape._native")?.getattr("_scene_from_state")?;
+        Ok((restore, PyTuple::new(py, [scene_state(py, &self.inner, self.time_limit)?])?))
+    }
+
+    /// The scene drawn as `pdeshape render` draws it (PNG bytes): Jupyter shows it.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let scene = self.inner.clone();
+        let img = limited(py, self.time_limit, "the picture", move || model::render_scene(&scene))?
+            .map_err(PyRuntimeError::new_err)?;
+        png_bytes(py, &img)
+    }
+
     /// Loads and solves a scene file. Keyword arguments override parameters
     /// (`Scene.load(path, a=1.37)`); `solver` ("auto", "exact", "collocation") and `terms`
     /// override blends' solvers as the CLI's `--solver` and `--terms` do; `limits` sets caps
@@ -277,8 +340,7 @@ impl Scene {
     /// The scene's diagnostics: the same report as `pdeshape check --json`, as a dict.
     fn check<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let scene = self.inner.clone();
-        let text = py
-            .detach(move || serde_json::to_string(&model::scene_diagnostics(&scene)))
+        let text = pool::detached(py, move || serde_json::to_string(&model::scene_diagnostics(&scene)))
             .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
         py.import("json")?.call_method1("loads", (text,))
     }
@@ -293,7 +355,7 @@ impl Scene {
             None => path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase(),
         };
         let scene = self.inner.clone();
-        py.detach(move || -> Result<(), String> {
+        pool::detached(py, move || -> Result<(), String> {
             if ext == "png" {
                 let img = model::render_scene(&scene)?;
                 return write_atomic(&path, |w| img.write_png(w))
@@ -312,6 +374,56 @@ impl Scene {
     fn __repr__(&self) -> String {
         format!("<pdeshape.Scene {} ({} patches)>", self.inner.file, self.inner.patches.len())
     }
+}
+
+/// What a pickled scene holds: a dict of its text, labels and load options.
+fn scene_state<'py>(py: Python<'py>, s: &IoScene, time_limit: f64) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("text", &s.source)?;
+    d.set_item("file", &s.file)?;
+    d.set_item("name", &s.name)?;
+    let params = PyDict::new(py);
+    for (k, v) in &s.options.params {
+        params.set_item(k, *v)?;
+    }
+    d.set_item("params", params)?;
+    d.set_item("solver", s.options.solver.clone())?;
+    d.set_item("terms", s.options.terms)?;
+    let limits = PyDict::new(py);
+    for cap in Cap::ALL {
+        limits.set_item(cap.name(), s.options.limits.get(cap))?;
+    }
+    d.set_item("limits", limits)?;
+    d.set_item("time_limit", time_limit)?;
+    Ok(d)
+}
+
+/// Unpickles a scene: [`scene_state`]'s dict solved again.
+#[pyfunction]
+fn _scene_from_state(py: Python<'_>, state: &Bound<'_, PyDict>) -> PyResult<Scene> {
+    let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+        state.get_item(k)?.ok_or_else(|| PyValueError::new_err(format!("a pickled scene without `{k}`")))
+    };
+    let text: String = get("text")?.extract()?;
+    let file: String = get("file")?.extract()?;
+    let name: String = get("name")?.extract()?;
+    let limits = get("limits")?;
+    let params = get("params")?;
+    let opts = Scene::options(
+        get("solver")?.extract()?,
+        get("terms")?.extract()?,
+        Some(limits.cast::<PyDict>()?),
+        Some(params.cast::<PyDict>()?),
+    )?;
+    let time_limit = self::time_limit(get("time_limit")?.extract()?)?;
+    Scene::build(&text, &file, &name, opts, time_limit, py)
+}
+
+/// A picture as PNG bytes.
+fn png_bytes<'py>(py: Python<'py>, img: &pdeshape_io::render::Image) -> PyResult<Bound<'py, PyBytes>> {
+    let mut buf = Vec::new();
+    img.write_png(&mut buf).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    Ok(PyBytes::new(py, &buf))
 }
 
 /// One solved patch of a scene.
@@ -468,7 +580,7 @@ impl Patch {
                 Cow::Owned(c)
             }
         };
-        let out = py.detach(|| {
+        let out = pool::detached(py, || {
             points_into(target, &params, &mut out);
             out
         });
@@ -502,7 +614,7 @@ impl Patch {
         let n = a.nrows();
         let per = (du + 1) * (dv + 1) * 3;
         let mut out = self.buffer(n as u128 * per as u128, "the array of derivatives")?;
-        let out = py.detach(|| {
+        let out = pool::detached(py, || {
             for (dst, row) in out.chunks_mut(per).zip(a.outer_iter()) {
                 for (k, d) in s.derivatives(row[0], row[1], du, dv).iter().enumerate() {
                     dst[3 * k..3 * k + 3].copy_from_slice(&[d.x, d.y, d.z]);
@@ -552,10 +664,42 @@ impl Patch {
         Ok(Mesh::from_core(py, &m))
     }
 
+    /// Pickling: the scene's state and the patch's index (unpickling solves the scene
+    /// again, as a pickled `Scene` does).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let restore = py.import("pdeshape._native")?.getattr("_patch_from_state")?;
+        let state = scene_state(py, &self.scene, self.time_limit)?;
+        Ok((restore, (state, self.index).into_pyobject(py)?))
+    }
+
+    /// The patch drawn alone in the scene's view (PNG bytes): Jupyter shows it.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let p = self.get().clone();
+        let r = self.scene.render.clone();
+        let img = limited(py, self.time_limit, "the picture", move || {
+            model::patch_mesh(&p).map(|m| model::render_meshes(&[m], &[], &[p.color], &r))
+        })?
+        .map_err(PyRuntimeError::new_err)?;
+        png_bytes(py, &img)
+    }
+
     fn __repr__(&self) -> String {
         let p = self.get();
         format!("<pdeshape.Patch {} ({})>", p.name, p.kind.name())
     }
+}
+
+/// Unpickles a patch: its scene solved again, the patch at `index`.
+#[pyfunction]
+fn _patch_from_state(py: Python<'_>, state: &Bound<'_, PyDict>, index: usize) -> PyResult<Patch> {
+    let scene = _scene_from_state(py, state)?;
+    if index >= scene.inner.patches.len() {
+        return Err(PyValueError::new_err(format!(
+            "a pickled patch {index} of a scene of {} patches",
+            scene.inner.patches.len()
+        )));
+    }
+    Ok(Patch { scene: scene.inner, index, time_limit: scene.time_limit })
 }
 
 /// A triangle mesh as numpy arrays, ready for trimesh, pyvista, libigl or matplotlib:
@@ -613,6 +757,127 @@ impl Mesh {
 
 #[pymethods]
 impl Mesh {
+    /// A mesh from arrays: `vertices` (N, 3) floats, `faces` (M, 3) indices into them,
+    /// and optionally `normals` (N, 3), `uvs` (N, 2) and `fields` (name → (N,)). The arrays
+    /// are copied into float64 and uint32 arrays; errors name the array and the index.
+    #[new]
+    #[pyo3(signature = (vertices, faces, normals=None, uvs=None, fields=None, name="mesh"))]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+        normals: Option<&Bound<'_, PyAny>>,
+        uvs: Option<&Bound<'_, PyAny>>,
+        fields: Option<&Bound<'_, PyDict>>,
+        name: &str,
+    ) -> PyResult<Mesh> {
+        let np = py.import("numpy")?;
+        let floats = |a: &Bound<'_, PyAny>, what: &str, cols: usize| -> PyResult<Py<PyArray2<f64>>> {
+            let a = np.call_method1("array", (a, "float64"))?;
+            let arr: Bound<'_, PyArray2<f64>> =
+                a.cast_into().map_err(|_| PyValueError::new_err(format!("{what}: an array of shape (N, {cols})")))?;
+            let view = arr.readonly();
+            let v = view.as_array();
+            if v.ncols() != cols {
+                return Err(PyValueError::new_err(format!("{what}: shape {:?}, not (N, {cols})", v.shape())));
+            }
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(PyValueError::new_err(format!(
+                    "{what}[{}, {}] = {} is not finite",
+                    i / cols,
+                    i % cols,
+                    v.iter().nth(i).copied().unwrap_or(f64::NAN)
+                )));
+            }
+            drop(view);
+            Ok(arr.unbind())
+        };
+        let vertices = floats(vertices, "vertices", 3)?;
+        let n = vertices.bind(py).shape()[0];
+        let f = np.call_method1("array", (faces, "int64"))?;
+        let f: Bound<'_, PyArray2<i64>> =
+            f.cast_into().map_err(|_| PyValueError::new_err("faces: an integer array of shape (M, 3)"))?;
+        let fv = f.readonly();
+        let fa = fv.as_array();
+        if fa.ncols() != 3 {
+            return Err(PyValueError::new_err(format!("faces: shape {:?}, not (M, 3)", fa.shape())));
+        }
+        let mut tris = Vec::with_capacity(fa.len());
+        for (i, r) in fa.rows().into_iter().enumerate() {
+            for k in 0..3 {
+                if r[k] < 0 || r[k] as u128 >= n as u128 {
+                    return Err(PyValueError::new_err(format!(
+                        "faces[{i}, {k}] = {}: out of range for {n} vertices",
+                        r[k]
+                    )));
+                }
+                tris.push(r[k] as u32);
+            }
+        }
+        let nf = fa.nrows();
+        let per_vertex = |a: Py<PyArray2<f64>>, what: &str| -> PyResult<Py<PyArray2<f64>>> {
+            let rows = a.bind(py).shape()[0];
+            if rows != n {
+                return Err(PyValueError::new_err(format!("{what}: {rows} rows for {n} vertices")));
+            }
+            Ok(a)
+        };
+        let normals = normals.map(|a| floats(a, "normals", 3).and_then(|a| per_vertex(a, "normals"))).transpose()?;
+        let uvs = uvs.map(|a| floats(a, "uvs", 2).and_then(|a| per_vertex(a, "uvs"))).transpose()?;
+        let out_fields = PyDict::new(py);
+        if let Some(fields) = fields {
+            for (k, v) in fields.iter() {
+                let key: String = k.extract().map_err(|_| PyTypeError::new_err("fields: the keys are names (str)"))?;
+                let a = np.call_method1("array", (v, "float64"))?;
+                let a: Bound<'_, PyArray1<f64>> = a
+                    .cast_into()
+                    .map_err(|_| PyValueError::new_err(format!("fields['{key}']: an array of shape (N,)")))?;
+                if a.len() != n {
+                    return Err(PyValueError::new_err(format!("fields['{key}']: {} values for {n} vertices", a.len())));
+                }
+                out_fields.set_item(key, a)?;
+            }
+        }
+        Ok(Mesh {
+            name: name.to_string(),
+            vertices,
+            faces: Array2::from_shape_vec((nf, 3), tris).expect("3 per face").into_pyarray(py).unbind(),
+            normals,
+            uvs,
+            fields: out_fields.unbind(),
+        })
+    }
+
+    /// Pickling: the arrays (numpy pickles them).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let cls = py.import("pdeshape._native")?.getattr("Mesh")?;
+        let args = (
+            self.vertices.clone_ref(py),
+            self.faces.clone_ref(py),
+            self.normals.as_ref().map(|a| a.clone_ref(py)),
+            self.uvs.as_ref().map(|a| a.clone_ref(py)),
+            self.fields.clone_ref(py),
+            self.name.clone(),
+        );
+        Ok((cls, args.into_pyobject(py)?))
+    }
+
+    /// The mesh drawn shaded (PNG bytes), in the view `render` gives mesh files: Jupyter
+    /// shows it.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let v = self.vertices.bind(py).readonly();
+        let positions: Vec<Vec3> = v.as_array().rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect();
+        let f = self.faces.bind(py).readonly();
+        let triangles: Vec<[u32; 3]> = f.as_array().rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+        drop((v, f));
+        let img = pool::detached(py, move || {
+            let m = pdeshape_core::trimesh::TriMesh { positions, triangles };
+            pdeshape_io::mesh_holes::render_trimesh(&m, &pdeshape_io::scene::RenderSettings::default())
+        })
+        .map_err(PyRuntimeError::new_err)?;
+        png_bytes(py, &img)
+    }
+
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "<pdeshape.Mesh {}: {} vertices, {} triangles>",
@@ -656,7 +921,7 @@ fn model_error(e: impl std::fmt::Display) -> PyErr {
 #[pyo3(signature = (path, *, limits=None))]
 fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyAny>> {
     let limits = limits_of(limits)?;
-    let report = py.detach(|| -> Result<serde_json::Value, String> {
+    let report = pool::detached(py, || -> Result<serde_json::Value, String> {
         if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
             let mf = pdeshape_io::import::mesh::read_mesh(&path, &limits).map_err(|e| e.to_string())?;
             let loops = pdeshape_core::trimesh::boundary(&mf.mesh).map_err(|e| format!("{}: {e}", mf.file))?;
@@ -829,7 +1094,7 @@ fn fill_mesh_arrays(
 ///
 /// Errors in scene files raise `pdeshape.SceneError` with the file, line and column.
 #[pymodule]
-fn pdeshape(m: &Bound<'_, PyModule>) -> PyResult<()> {
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<Patch>()?;
     m.add_class::<Mesh>()?;
@@ -837,6 +1102,8 @@ fn pdeshape(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ModelError", m.py().get_type::<ModelError>())?;
     m.add_function(wrap_pyfunction!(holes, m)?)?;
     m.add_function(wrap_pyfunction!(fill_holes, m)?)?;
+    m.add_function(wrap_pyfunction!(_scene_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(_patch_from_state, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

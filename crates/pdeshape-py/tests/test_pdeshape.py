@@ -375,3 +375,23 @@ def test_fill_holes_of_numpy_arrays():
         pdeshape.fill_holes(v, np.array([[0, 1, 5000]]))
     with pytest.raises(ValueError, match=r"vertices: shape \(3, 2\)"):
         pdeshape.fill_holes(np.zeros((3, 2)), np.array([[0, 1, 2]]))
+
+
+def _check_and_evaluate(scene):
+    p = scene.patches[0]
+    uv = np.column_stack([np.linspace(0, 1, 5000), np.linspace(0, 6, 5000)])
+    return scene.check()["patches"][0]["condition_error"]["max_abs"], p.evaluate(uv)
+
+
+def test_a_forked_child_computes_after_its_parent_did():
+    """Regression: a child forked after the parent's first parallel loop (the default
+    start method of multiprocessing on Linux) waited for ever on the inherited rayon pool,
+    which has no threads in the child."""
+    import multiprocessing
+
+    scene = pdeshape.Scene.load(ROOT / "examples/bloor-wilson-blend.toml")
+    here = _check_and_evaluate(scene)  # the parent's pools start here
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        there = pool.apply_async(_check_and_evaluate, (scene,)).get(timeout=120)
+    assert there[0] == here[0]
+    assert there[1].tobytes() == here[1].tobytes()

@@ -119,6 +119,31 @@ pub fn apply(text: &str, edits: &[Edit]) -> Result<String, String> {
     Ok(doc.to_string())
 }
 
+/// The scene text with parameter values replaced (`a = 1.37` for `--set a=1.37`): the text
+/// that, parsed without overrides, resolves as `text` does with them. A parameter written
+/// as a table (`a = { value = 1, min = 0 }`) gets its `value` replaced, its range kept; an
+/// expression parameter given a value becomes that number, as an override makes it. Names
+/// go in sorted order, so the text is the same for the same overrides.
+pub fn with_parameters(text: &str, values: &std::collections::HashMap<String, f64>) -> Result<String, String> {
+    if values.is_empty() {
+        return Ok(text.to_string());
+    }
+    let doc: DocumentMut = text.parse().map_err(|e| format!("scene text: {e}"))?;
+    let params = doc.get("parameters").and_then(|p| p.as_table_like());
+    let mut names: Vec<&String> = values.keys().collect();
+    names.sort();
+    let mut edits = Vec::with_capacity(names.len());
+    for name in names {
+        let entry = params.and_then(|p| p.get(name)).ok_or_else(|| format!("unknown parameter `{name}`"))?;
+        let mut path = vec![Seg::Key("parameters".into()), Seg::Key(name.clone())];
+        if entry.is_table_like() {
+            path.push(Seg::Key("value".into()));
+        }
+        edits.push(Edit { op: None, path, value: serde_json::Value::from(values[name]) });
+    }
+    apply(text, &edits)
+}
+
 fn numbers(v: &TValue) -> Option<Vec<f64>> {
     let a = v.as_array()?;
     a.iter().map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect()
@@ -193,6 +218,26 @@ mod tests {
         assert!(e.contains("no such entry `d`"), "{e}");
         let e = apply(text, &[edit("delete", json!(["curves", "c", "bspline", 7]), Value::Null)]).unwrap_err();
         assert!(e.contains("index 7 of an array of 3"), "{e}");
+    }
+
+    /// A parameter set in the text resolves as the same override does, bit for bit, in
+    /// both of its written forms (a bare value or expression, a table with a range).
+    #[test]
+    fn parameters_written_into_the_text_resolve_as_overrides() {
+        let text = "[parameters]\nr = 2\nk = \"2*r\"\na = { value = 1.0, min = 0.1, max = 3.0 }\n\
+                    [curves.c]\nexpr = [\"r*cos(v)\", \"k*sin(v)\", \"a\"]\n";
+        let mut values = std::collections::HashMap::new();
+        values.insert("a".to_string(), 0.1 + 0.2);
+        values.insert("k".to_string(), 1.0 / 3.0);
+        let out = with_parameters(text, &values).unwrap();
+        let written = super::super::Scene::parse(&out, "t", "t", &Default::default()).unwrap();
+        let overridden = super::super::Scene::parse(text, "t", "t", &values).unwrap();
+        for name in ["r", "k", "a"] {
+            assert_eq!(written.params[name].value.to_bits(), overridden.params[name].value.to_bits(), "{name}");
+        }
+        assert_eq!(written.params["a"].min, Some(0.1), "{out}");
+        let e = with_parameters(text, &[("b".to_string(), 1.0)].into_iter().collect()).unwrap_err();
+        assert!(e.contains("unknown parameter `b`"), "{e}");
     }
 
     /// Regression: JSON integers became TOML floats, so editing `resolution` (integers

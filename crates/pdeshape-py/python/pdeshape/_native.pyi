@@ -1,7 +1,7 @@
-"""PDE-based shape design: exact PDE surfaces, blends and solids from numpy."""
+"""The Rust extension of `pdeshape` (the package re-exports it)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Tuple, Union, overload
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -44,8 +44,8 @@ def fill_holes(
 
 @overload
 def fill_holes(
-    model: npt.ArrayLike,
-    out: npt.ArrayLike,
+    model: Union[npt.NDArray[Any], Sequence[Sequence[float]]],
+    out: Union[npt.NDArray[Any], Sequence[Sequence[int]]],
     *,
     order: int = 4,
     holes: Optional[List[int]] = None,
@@ -67,6 +67,17 @@ class Mesh:
     normals: Optional[npt.NDArray[np.float64]]  # (N, 3), unit
     uvs: Optional[npt.NDArray[np.float64]]  # (N, 2), parameters scaled to [0, 1]
     fields: Dict[str, npt.NDArray[np.float64]]  # name -> (N,)
+    def __init__(
+        self,
+        vertices: npt.ArrayLike,
+        faces: npt.ArrayLike,
+        normals: Optional[npt.ArrayLike] = None,
+        uvs: Optional[npt.ArrayLike] = None,
+        fields: Optional[Dict[str, npt.ArrayLike]] = None,
+        name: str = "mesh",
+    ) -> None:
+        """A mesh from arrays (copied to float64 / uint32); errors name the array and index."""
+    def _repr_png_(self) -> bytes: ...
 
 class Patch:
     """One solved patch of a scene."""
@@ -95,13 +106,33 @@ class Patch:
         """Exact partials (N, du+1, dv+1, 3); ``[k, i, j]`` is d^(i+j)X/du^i dv^j at uv[k]."""
     def mesh(self, resolution: Optional[Tuple[int, int]] = None, t: Optional[float] = None) -> Mesh:
         """The patch's mesh as the exporters write it."""
+    def _repr_png_(self) -> bytes: ...
 
 class Scene:
     """A loaded, solved scene (immutable: ``set`` returns a new one)."""
 
+    def __init__(
+        self,
+        *,
+        name: str = "scene",
+        solver: Optional[str] = None,
+        terms: Optional[int] = None,
+        limits: Optional[Dict[str, int]] = None,
+        time_limit: Optional[float] = None,
+        **tables: Any,
+    ) -> None:
+        """A scene from Python values in the scene file's vocabulary: each keyword is a
+        top-level table (scene, parameters, curves, surfaces, patches, render, output,
+        studies); ``Scene(**tomllib.load(f))`` is the scene of file ``f``."""
+    def to_toml(self) -> str:
+        """The scene text solved, with ``set``'s values written in."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Dict[str, Any]]]:
+        """Pickling: ``(restore, (state,))``, the state a dict of the text and options."""
+    def _repr_png_(self) -> bytes: ...
+
     @staticmethod
     def load(
-        path: Union[str, PathLike],
+        path: Union[str, PathLike[str]],
         *,
         solver: Optional[str] = None,
         terms: Optional[int] = None,
@@ -142,5 +173,8 @@ class Scene:
     def __len__(self) -> int: ...
     def check(self) -> Dict[str, Any]:
         """The report ``pdeshape check --json`` prints."""
-    def export(self, path: Union[str, PathLike], format: Optional[str] = None) -> None:
+    def export(self, path: Union[str, PathLike[str]], format: Optional[str] = None) -> None:
         """Writes every patch's mesh (obj, ply, stl, gltf, glb, vtu, ...) or a png picture."""
+
+def _scene_from_state(state: Dict[str, Any]) -> Scene: ...
+def _patch_from_state(state: Dict[str, Any], index: int) -> Patch: ...
