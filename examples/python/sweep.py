@@ -2,7 +2,7 @@
 
 The solid blend of paper 000's example 2 (elliptic cylinder to circular cylinder) with the
 axial cross-tangent `k` at both ends as a parameter: for each k the blend is solved again,
-its mass properties read from the diagnostics (`scene.check()`, the same report as
+by `pdeshape.sweep`, its mass properties read from the diagnostics (`scene.check()`, the same report as
 `pdeshape check --json`), and the volume and the smallest Jacobian (a fold where it reaches
 zero) plotted against k, with the height of a point on the outer wall a quarter of the way
 along (the tangent's reach).
@@ -11,6 +11,7 @@ along (the tangent's reach).
 """
 
 import sys
+from typing import Dict
 
 import matplotlib
 
@@ -38,18 +39,20 @@ cells = [9, 49, 17]
 """
 
 
-def main(out="sweep.png"):
+def measure(scene: pdeshape.Scene) -> Dict[str, float]:
+    """The figures of one setting: volume and smallest Jacobian from the diagnostics, and
+    the height of the outer wall's point (u, v, w) = (1, 0, 1/4)."""
+    mass = scene.check()["patches"][0]["mass_properties"]
+    z = scene.patches[0].evaluate(np.array([[1.0, 0.0, 0.25]]))[0, 2]
+    return {"volume": mass["volume"], "min_jacobian": mass["min_jacobian"], "z_mid": float(z)}
+
+
+def main(out: str = "sweep.png") -> None:
     base = pdeshape.Scene.from_toml(SCENE, "solid-sweep")
-    ks = np.linspace(0.5, 6.0, 23)
-    volume, min_jacobian, mid = [], [], []
-    for k in ks:
-        scene = base.set(k=float(k))
-        mass = scene.check()["patches"][0]["mass_properties"]
-        volume.append(mass["volume"])
-        min_jacobian.append(mass["min_jacobian"])
-        # the point on the outer wall (u = 1) a quarter of the way along (w = 1/4), v = 0
-        mid.append(scene.patches[0].evaluate(np.array([[1.0, 0.0, 0.25]]))[0])
-    mid = np.array(mid)
+    # one solve per setting; pass executor=ProcessPoolExecutor() or a Dask Client to spread
+    # the settings over processes or machines
+    table = pdeshape.sweep(base, {"k": np.linspace(0.5, 6.0, 23)}, measure=measure, table="dict")
+    ks, volume, min_jacobian = table["k"], table["volume"], table["min_jacobian"]
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     ax1.plot(ks, volume, "o-")
@@ -61,7 +64,7 @@ def main(out="sweep.png"):
     ax2.set_xlabel("cross-tangent length k")
     ax2.set_title("Smallest Jacobian (a fold at 0)")
     ax2b = ax2.twinx()
-    ax2b.plot(ks, mid[:, 2], "s--", color="tab:red", label="z of X(1, 0, ¼)")
+    ax2b.plot(ks, table["z_mid"], "s--", color="tab:red", label="z of X(1, 0, ¼)")
     ax2b.set_ylabel("z of X(1, 0, 1/4)", color="tab:red")
     fig.tight_layout()
     fig.savefig(out, dpi=120)
