@@ -26,13 +26,8 @@ fn current() -> Option<Arc<rayon::ThreadPool>> {
     if let Some(inherited) = slot.take() {
         std::mem::forget(inherited);
     }
-    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .thread_name(|i| format!("pdeshape-py-{i}"))
-        .build()
-        .ok()
-        .map(Arc::new);
+    // as many threads as rayon's global pool would have: RAYON_NUM_THREADS, else the cores
+    let pool = rayon::ThreadPoolBuilder::new().thread_name(|i| format!("pdeshape-py-{i}")).build().ok().map(Arc::new);
     *slot = pool.clone().map(|p| (pid, p));
     pool
 }

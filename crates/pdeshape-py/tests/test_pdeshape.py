@@ -395,3 +395,23 @@ def test_a_forked_child_computes_after_its_parent_did():
         there = pool.apply_async(_check_and_evaluate, (scene,)).get(timeout=120)
     assert there[0] == here[0]
     assert there[1].tobytes() == here[1].tobytes()
+
+
+def test_the_module_pool_takes_rayon_num_threads():
+    """Regression: the module's own pool (made for forked children) had one thread per
+    core whatever RAYON_NUM_THREADS said, so one-thread measurements ran on all cores."""
+    import sys
+
+    code = (
+        "import glob, numpy as np, pdeshape\n"
+        f"p = pdeshape.Scene.load({str(ROOT / 'examples/bloor-wilson-blend.toml')!r}).patches[0]\n"
+        "p.evaluate(np.column_stack([np.linspace(0, 1, 10000), np.zeros(10000)]))\n"
+        "names = [open(f).read().strip() for f in glob.glob('/proc/self/task/*/comm')]\n"
+        "print(sum(n.startswith('pdeshape-py-') for n in names))\n"
+    )
+    if not Path("/proc/self/task").is_dir():
+        pytest.skip("threads are counted in /proc")
+    for n in (1, 3):
+        env = dict(os.environ, RAYON_NUM_THREADS=str(n))
+        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+        assert out.stdout.strip() == str(n), (n, out.stdout, out.stderr)
