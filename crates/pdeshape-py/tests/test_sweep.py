@@ -52,8 +52,8 @@ def test_a_serial_sweep_equals_scenes_solved_one_by_one(tmp_path):
 def test_sweeps_on_executors_equal_the_serial_sweep():
     pd = pytest.importorskip("pandas")
     scene = pdeshape.Scene.load(BLEND)
-    # (the blend is axially symmetric, so only mode 0 is not zero and `a` changes nothing:
-    # the tangent length k0 moves the surface)
+    # (the blend's z is mode 0 alone, which `a` does not change; the measured height z_mid
+    # moves with the tangent length k0)
     values = {"k0": np.linspace(0.3, 2.5, 10)}
     serial = pdeshape.sweep(scene, values, measure=point_height, progress=False)
     assert isinstance(serial, pd.DataFrame) and list(serial.columns) == ["k0", "z_mid", "condition_error"]
