@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import pdeshape
+from helpers import random_params
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
@@ -27,15 +28,6 @@ def cli():
         if c.is_file():
             return str(c)
     pytest.fail(f"no pdeshape binary at {candidates}: run `cargo build` first or set PDESHAPE_BIN")
-
-
-def random_params(patch, n, seed):
-    """n random parameter rows inside the patch's domain."""
-    rng = np.random.default_rng(seed)
-    if patch.kind == "solid":
-        return rng.random((n, 3))
-    start, end, _ = patch.v_domain
-    return np.column_stack([rng.random(n), start + (end - start) * rng.random(n)])
 
 
 def test_examples_exist():

@@ -14,17 +14,10 @@ import numpy as np
 import pytest
 
 import pdeshape
+from helpers import random_params
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
-
-
-def random_params(patch, n, seed):
-    rng = np.random.default_rng(seed)
-    if patch.kind == "solid":
-        return rng.random((n, 3))
-    start, end, _ = patch.v_domain
-    return np.column_stack([rng.random(n), start + (end - start) * rng.random(n)])
 
 
 def assert_same_scene(a, b, n=200):
