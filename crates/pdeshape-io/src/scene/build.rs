@@ -2,6 +2,7 @@
 
 use super::ctx::{Ctx, R, find_surface, is_reserved, span, toml_error};
 use super::error::Source;
+use super::nurbs;
 use super::raw::*;
 use super::{Param, RenderSettings, Scene, SceneSurface};
 use indexmap::IndexMap;
@@ -291,6 +292,18 @@ impl CurveBuilder<'_, '_> {
         only_for(!spline_like && c.closed.is_some(), "closed", "bspline and polyline")?;
         only_for(!spline_like && c.range.is_some(), "range", "bspline and polyline")?;
         only_for(c.bspline.is_none() && c.degree.is_some(), "degree", "bspline")?;
+        only_for(c.bspline.is_none() && c.knots.is_some(), "knots", "bspline")?;
+        only_for(c.bspline.is_none() && c.weights.is_some(), "weights", "bspline")?;
+        if c.closed == Some(true) && (c.knots.is_some() || c.weights.is_some()) {
+            return Err(ctx.err(
+                span(rc),
+                key,
+                "`knots` and `weights` apply to open B-splines (a closed one has uniform knots)",
+            ));
+        }
+        if let (Some(k), Some(_)) = (&c.knots, &c.range) {
+            return Err(ctx.err(span(k), key, "give `knots` or `range`, not both: the knots are the parameter"));
+        }
         let trim = c.surface.is_some();
         only_for(
             !trim && (c.s.is_some() || c.derivative.is_some() || c.scale.is_some()),
@@ -331,6 +344,12 @@ impl CurveBuilder<'_, '_> {
             {
                 // A repeated end point on an open curve is legitimate (a closed polygon as an
                 // open spline); nothing to do.
+            }
+            if c.knots.is_some() || c.weights.is_some() {
+                let given = c.degree.as_ref().map(|_| degree);
+                let range = c.range.as_ref().map(|_| range);
+                let curve = nurbs::curve(ctx, key, c, (&points, span(pts)), given, range)?;
+                return Ok(Arc::new(curve));
             }
             let curve =
                 BSplineCurve::new(points, degree, closed, range).map_err(|e| ctx.err(span(pts), &k, e.to_string()))?;
@@ -412,9 +431,35 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
     for (n, s) in &raw.surfaces {
         let key = format!("surfaces.{n}");
         let rs = s.get_ref();
-        let field: FieldRef = Arc::new(ctx.field(&rs.expr, &["s", "v", "t"], &format!("{key}.expr"))?);
+        let (field, domain): (FieldRef, _) = match (&rs.expr, &rs.bspline) {
+            (Some(x), None) => {
+                for (given, what) in
+                    [(rs.degree.is_some(), "degree"), (rs.knots.is_some(), "knots"), (rs.weights.is_some(), "weights")]
+                {
+                    if given {
+                        return Err(ctx.err(span(s), &key, format!("`{what}` only applies to bspline surfaces")));
+                    }
+                }
+                let field = Arc::new(ctx.field(x, &["s", "v", "t"], &format!("{key}.expr"))?);
+                (field, ctx.domain(&rs.v, &format!("{key}.v"))?)
+            }
+            (None, Some(_)) => {
+                if let Some(v) = &rs.v {
+                    return Err(ctx.err(span(v), format!("{key}.v"), "a bspline surface's v domain is its knot range"));
+                }
+                let (surface, domain) = nurbs::surface(&ctx, &key, rs)?;
+                (Arc::new(surface), domain)
+            }
+            (x, _) => {
+                let msg = if x.is_some() {
+                    "the surface has several definitions (expr, bspline); give exactly one"
+                } else {
+                    "the surface has no definition (expected one of: expr, bspline)"
+                };
+                return Err(ctx.err(span(s), &key, msg));
+            }
+        };
         let s_range = rs.s_range.as_ref().map(|r| ctx.range(r, &format!("{key}.s_range"))).transpose()?;
-        let domain = ctx.domain(&rs.v, &format!("{key}.v"))?;
         let resolution = ctx.resolution(&rs.resolution, (17, 65), &format!("{key}.resolution"))?;
         surfaces.push(SceneSurface { name: n.clone(), field, s_range, domain, resolution });
     }

@@ -13,6 +13,7 @@ mod ctx;
 pub mod edit;
 mod error;
 mod kinds;
+mod nurbs;
 mod raw;
 mod sections;
 mod trim;

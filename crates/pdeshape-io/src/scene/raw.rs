@@ -86,13 +86,28 @@ pub struct RawCurve {
     pub degree: Option<Spanned<i64>>,
     /// Parameter range of a B-spline/polyline (default `[0, 2π]` closed, `[0, 1]` open).
     pub range: Option<Spanned<[NumOrExpr; 2]>>,
+    /// An open B-spline's whole knot vector (`n + degree + 1` non-decreasing values); the
+    /// curve's parameter is the knot parameter.
+    pub knots: Option<Spanned<Vec<NumOrExpr>>>,
+    /// An open B-spline's weights, one per control point (a rational curve).
+    pub weights: Option<Spanned<Vec<NumOrExpr>>>,
 }
 
 /// `[surfaces.NAME]`: a primary parametric surface `S(s, v, t)`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSurface {
-    pub expr: Spanned<[NumOrExpr; 3]>,
+    /// Three expressions in `s`, `v` (and `t`).
+    pub expr: Option<Spanned<[NumOrExpr; 3]>>,
+    /// A B-spline net: rows along `s`, each a list of points along `v`.
+    pub bspline: Option<Spanned<Vec<Vec<[NumOrExpr; 3]>>>>,
+    /// The net's degrees `[in s, in v]` (default: what the knots imply, else `[3, 3]` lowered
+    /// to what the net allows).
+    pub degree: Option<Spanned<[i64; 2]>>,
+    /// The net's whole knot vectors `[in s, in v]` (default clamped uniform on `[0, 1]`).
+    pub knots: Option<Spanned<[Vec<NumOrExpr>; 2]>>,
+    /// The net's weights, rows like the points (a rational surface).
+    pub weights: Option<Spanned<Vec<Vec<NumOrExpr>>>>,
     /// Range of `s` drawn in context (omit to hide the surface).
     pub s_range: Option<Spanned<[NumOrExpr; 2]>>,
     /// v domain (default periodic).
