@@ -99,7 +99,7 @@ fn every_example_evaluates_the_same_in_batches() {
 }
 
 /// The examples of the repository, in file-name order.
-const EXAMPLES: [&str; 26] = [
+const EXAMPLES: [&str; 27] = [
     "blend-cone-cylinder",
     "blend-torus-hyperboloid",
     "bloor-wilson-blend",
@@ -108,6 +108,7 @@ const EXAMPLES: [&str; 26] = [
     "dynamic-linear",
     "dynamic-sine",
     "fill-box-corner",
+    "fill-bspline-hole",
     "fill-sphere-hexagon",
     "fill-sphere-pentagon",
     "fill-sphere-triangle",

@@ -116,6 +116,7 @@ every_example! {
     dynamic_linear => "dynamic-linear.toml",
     dynamic_sine => "dynamic-sine.toml",
     fill_box_corner => "fill-box-corner.toml",
+    fill_bspline_hole => "fill-bspline-hole.toml",
     fill_sphere_hexagon => "fill-sphere-hexagon.toml",
     fill_sphere_pentagon => "fill-sphere-pentagon.toml",
     fill_sphere_triangle => "fill-sphere-triangle.toml",
