@@ -40,6 +40,21 @@ pyo3::create_exception!(
      `e.column` (1-based, or None) and `e.key` (dotted key path) give the place."
 );
 
+/// `pdeshape.notebook.show(obj, ...)`: the view is drawn by the Python side's widget code.
+fn notebook_show<'py>(
+    obj: &Bound<'py, PyAny>,
+    resolution: Option<(usize, usize)>,
+    width: i64,
+    height: i64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("resolution", resolution)?;
+    kwargs.set_item("width", width)?;
+    kwargs.set_item("height", height)?;
+    py.import("pdeshape.notebook")?.getattr("show")?.call((obj,), Some(&kwargs))
+}
+
 /// A message as Python users read it: the CLI's advice "raise the cap with `--limit
 /// NAME=VALUE` (library: `Limits::NAME`)" becomes "pass `limits={'NAME': VALUE}`".
 fn py_message(s: &str) -> String {
@@ -192,7 +207,10 @@ impl Scene {
         tables: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
         let text = match tables {
-            Some(t) => toml_text::scene_text(t)?,
+            Some(t) => {
+                let opts = Scene::options(None, None, limits, None)?;
+                toml_text::scene_text(t, &mut toml_text::Budget::new(&opts.limits))?
+            }
             None => String::new(),
         };
         Scene::from_toml(py, &text, name, solver, terms, limits, time_limit, None)
@@ -213,6 +231,18 @@ impl Scene {
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let restore = py.import("pdeshape._native")?.getattr("_scene_from_state")?;
         Ok((restore, PyTuple::new(py, [scene_state(py, &self.inner, self.time_limit)?])?))
+    }
+
+    /// An interactive 3D view in Jupyter (a pythreejs widget; `pip install pythreejs`):
+    /// see `pdeshape.notebook.show`.
+    #[pyo3(signature = (*, resolution=None, width=800, height=600))]
+    fn show<'py>(
+        slf: &Bound<'py, Self>,
+        resolution: Option<(usize, usize)>,
+        width: i64,
+        height: i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        notebook_show(slf.as_any(), resolution, width, height)
     }
 
     /// The scene drawn as `pdeshape render` draws it (PNG bytes): Jupyter shows it.
@@ -672,6 +702,18 @@ impl Patch {
         Ok((restore, (state, self.index).into_pyobject(py)?))
     }
 
+    /// An interactive 3D view in Jupyter (a pythreejs widget; `pip install pythreejs`):
+    /// see `pdeshape.notebook.show`.
+    #[pyo3(signature = (*, resolution=None, width=800, height=600))]
+    fn show<'py>(
+        slf: &Bound<'py, Self>,
+        resolution: Option<(usize, usize)>,
+        width: i64,
+        height: i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        notebook_show(slf.as_any(), resolution, width, height)
+    }
+
     /// The patch drawn alone in the scene's view (PNG bytes): Jupyter shows it.
     fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let p = self.get().clone();
@@ -709,16 +751,22 @@ fn _patch_from_state(py: Python<'_>, state: &Bound<'_, PyDict>, index: usize) ->
 /// float64 per-vertex values).
 #[pyclass(frozen, module = "pdeshape")]
 struct Mesh {
+    /// The patch's (or the given) name.
     #[pyo3(get)]
     name: String,
+    /// (N, 3) float64 vertex positions.
     #[pyo3(get)]
     vertices: Py<PyArray2<f64>>,
+    /// (M, 3) uint32 vertex indices, counter-clockwise about the normal.
     #[pyo3(get)]
     faces: Py<PyArray2<u32>>,
+    /// (N, 3) float64 unit normals (exact, from the surface's derivatives), or None.
     #[pyo3(get)]
     normals: Option<Py<PyArray2<f64>>>,
+    /// (N, 2) float64 patch parameters scaled to [0, 1], or None.
     #[pyo3(get)]
     uvs: Option<Py<PyArray2<f64>>>,
+    /// Per-vertex values: name → (N,) float64.
     #[pyo3(get)]
     fields: Py<PyDict>,
 }
@@ -860,6 +908,18 @@ impl Mesh {
             self.name.clone(),
         );
         Ok((cls, args.into_pyobject(py)?))
+    }
+
+    /// An interactive 3D view in Jupyter (a pythreejs widget; `pip install pythreejs`):
+    /// see `pdeshape.notebook.show`.
+    #[pyo3(signature = (*, resolution=None, width=800, height=600))]
+    fn show<'py>(
+        slf: &Bound<'py, Self>,
+        resolution: Option<(usize, usize)>,
+        width: i64,
+        height: i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        notebook_show(slf.as_any(), resolution, width, height)
     }
 
     /// The mesh drawn shaded (PNG bytes), in the view `render` gives mesh files: Jupyter

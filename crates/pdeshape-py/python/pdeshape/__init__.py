@@ -33,8 +33,10 @@ from .tables import (
     combine,
     dynamic,
     expr,
+    Interpolated,
     fill,
     hermite,
+    interpolate,
     pde,
     point,
     polyline,
@@ -44,6 +46,7 @@ from .tables import (
 )
 
 __all__ = [
+    "Interpolated",
     "Mesh",
     "ModelError",
     "Patch",
@@ -59,6 +62,7 @@ __all__ = [
     "fill_holes",
     "hermite",
     "holes",
+    "interpolate",
     "pde",
     "point",
     "polyline",
