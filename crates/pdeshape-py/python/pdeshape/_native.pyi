@@ -78,6 +78,8 @@ class Mesh:
     ) -> None:
         """A mesh from arrays (copied to float64 / uint32); errors name the array and index."""
     def _repr_png_(self) -> bytes: ...
+    def show(self, *, resolution: Optional[Tuple[int, int]] = None, width: int = 800, height: int = 600) -> Any:
+        """An interactive 3D view in Jupyter (a pythreejs widget)."""
 
 class Patch:
     """One solved patch of a scene."""
@@ -107,6 +109,8 @@ class Patch:
     def mesh(self, resolution: Optional[Tuple[int, int]] = None, t: Optional[float] = None) -> Mesh:
         """The patch's mesh as the exporters write it."""
     def _repr_png_(self) -> bytes: ...
+    def show(self, *, resolution: Optional[Tuple[int, int]] = None, width: int = 800, height: int = 600) -> Any:
+        """An interactive 3D view in Jupyter (a pythreejs widget)."""
 
 class Scene:
     """A loaded, solved scene (immutable: ``set`` returns a new one)."""
@@ -129,6 +133,8 @@ class Scene:
     def __reduce__(self) -> Tuple[Any, Tuple[Dict[str, Any]]]:
         """Pickling: ``(restore, (state,))``, the state a dict of the text and options."""
     def _repr_png_(self) -> bytes: ...
+    def show(self, *, resolution: Optional[Tuple[int, int]] = None, width: int = 800, height: int = 600) -> Any:
+        """An interactive 3D view in Jupyter (a pythreejs widget)."""
 
     @staticmethod
     def load(

@@ -12,7 +12,7 @@ import itertools
 import math
 import os
 import sys
-from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Union, cast
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, cast
 
 import numpy as np
 
@@ -60,6 +60,7 @@ def _run_chunk(
     settings: List[Setting],
     measure: Optional[Measure],
     mesh_dir: Optional[str],
+    mesh_resolution: Optional[Tuple[int, int]] = None,
 ) -> List[Dict[str, Any]]:
     """Solves the scene at each setting of one chunk (this runs on the worker)."""
     measure = measure or report_figures
@@ -73,17 +74,18 @@ def _run_chunk(
             raise _native.SceneError(f"sweep setting {first + k} {setting}: {e}") from e
         row: Dict[str, Any] = dict(measure(scene))
         if mesh_dir is not None:
-            row["mesh_file"] = _write_meshes(scene, os.path.join(mesh_dir, f"{first + k:06d}.npz"))
+            path = os.path.join(mesh_dir, f"{first + k:06d}.npz")
+            row["mesh_file"] = _write_meshes(scene, path, mesh_resolution)
         rows.append(row)
     return rows
 
 
-def _write_meshes(scene: "_native.Scene", path: str) -> str:
+def _write_meshes(scene: "_native.Scene", path: str, resolution: Optional[Tuple[int, int]] = None) -> str:
     """Every patch's mesh as arrays ``PATCH/vertices``, ``PATCH/faces`` (and normals, uvs)
     of one npz file, written atomically."""
     arrays: Dict[str, np.ndarray] = {}
     for patch in scene.patches:
-        m = patch.mesh()
+        m = patch.mesh(resolution=resolution)
         arrays[f"{patch.name}/vertices"] = m.vertices
         arrays[f"{patch.name}/faces"] = m.faces
         if m.normals is not None:
@@ -121,6 +123,7 @@ def sweep(
     measure: Optional[Measure] = None,
     executor: Any = None,
     meshes: Optional[Union[str, "os.PathLike[str]"]] = None,
+    mesh_resolution: Optional[Tuple[int, int]] = None,
     chunksize: Optional[int] = None,
     progress: Union[bool, Callable[[int, int], None], None] = None,
     table: str = "pandas",
@@ -139,7 +142,8 @@ def sweep(
     - ``meshes``: a directory; each setting's meshes go to ``NNNNNN.npz`` there (arrays
       ``PATCH/vertices``, ``PATCH/faces``, ``PATCH/normals``, ``PATCH/uvs``) and the
       table gets a ``mesh_file`` column. Workers write the files: on a cluster the
-      directory must be one they share.
+      directory must be one they share. ``mesh_resolution=(nu, nv)`` meshes every patch
+      at that resolution instead of its own.
     - ``progress``: ``True`` prints a counter on stderr (default: when stderr is a
       terminal), or a callable ``(done, total)``.
     - ``table``: ``"pandas"`` (a DataFrame), ``"pyarrow"`` (a Table) or ``"dict"`` (column
@@ -158,6 +162,11 @@ def sweep(
             if not math.isfinite(x):
                 raise ValueError(f"settings[{i}]: {name} = {x} is not finite")
     mesh_dir = None
+    if mesh_resolution is not None:
+        if meshes is None:
+            raise TypeError("sweep(): `mesh_resolution` is for the meshes written with `meshes=DIR`")
+        nu, nv = mesh_resolution
+        mesh_resolution = (int(nu), int(nv))
     if meshes is not None:
         mesh_dir = os.fspath(meshes)
         os.makedirs(mesh_dir, exist_ok=True)
@@ -171,11 +180,11 @@ def sweep(
     rows: List[Dict[str, Any]] = []
     if executor is None:
         for first in starts:
-            rows.extend(_run_chunk(state, first, settings[first : first + size], measure, mesh_dir))
+            rows.extend(_run_chunk(state, first, settings[first : first + size], measure, mesh_dir, mesh_resolution))
             tick(len(rows))
     else:
         futures = [
-            executor.submit(_run_chunk, state, first, settings[first : first + size], measure, mesh_dir)
+            executor.submit(_run_chunk, state, first, settings[first : first + size], measure, mesh_dir, mesh_resolution)
             for first in starts
         ]
         for f in futures:
