@@ -24,10 +24,12 @@ mod eval;
 mod expand;
 mod parse;
 mod tape;
+mod trig;
 
 pub use expand::{Term, expand};
 pub use parse::ExprError;
 pub use tape::{OutputIter, Tape, TapeNum};
+pub use trig::trig_degree;
 
 use std::fmt;
 

@@ -33,8 +33,12 @@ enum Kind {
     /// `k < N`, then `uᵏ e^{−cu}` (the order of [`super::ExpSpace::derivatives`]); `mat`
     /// is `Cᵀ`, `2N × 2N`, row-major (row `i`: `ℓ_i`'s coefficients), then the weights.
     Exp { c: f64, n: usize, mat: Vec<f64> },
-    /// A zero root of multiplicity `dim`: `T_b(2u − 1)`, `b < dim`; `mat` is `Cᵀ`.
-    Poly { dim: usize, mat: Vec<f64> },
+    /// A zero root of multiplicity `dim`: `T_b(2u − 1)`, `b < dim`; `mat` is `Cᵀ`, `cw` is
+    /// `C W` (`dim × cols`, row-major, each entry rounded once). Values alone go through
+    /// `cw` (mode 0 of an order-40 patch: 40 × 6 products a point instead of 40 × 40 and
+    /// 40 × 6); derivatives through the cardinal functions as pointwise, since folded they
+    /// moved the dolphin body's `X_u` by 1.7e-14 relative, over the 1e-14 the paths agree to.
+    Poly { dim: usize, mat: Vec<f64>, cw: Vec<f64> },
     /// Chebyshev series in `x = 2u − 1`: `mats[k]` holds the combined series of the
     /// `ℓ_i^{(k)}`, `cols × size`, row `c` the series of `F_c^{(k)}` (one dot product with
     /// `T_m(x)` per column, as [`super::UltraCardinal::eval`] does per function).
@@ -100,7 +104,28 @@ impl Combined {
                     (0..dim).flat_map(|i| (0..dim).map(move |b| (b, i))).map(|(b, i)| coef[(b, i)]).collect();
                 let kind = match space.roots() {
                     _ if space.clustered() => Kind::Generic,
-                    [Root { re, im: 0.0, mult }] if *re == 0.0 => Kind::Poly { dim: *mult, mat },
+                    [Root { re, im: 0.0, mult }] if *re == 0.0 => {
+                        // (C W)_bc = Σ_i C_bi W_ic, each rounded once (compensated: exact
+                        // products by FMA, error-free sums), so the folded sums lose no more
+                        // than the pointwise ones do
+                        let mut cw = vec![0.0; dim * cols];
+                        for b in 0..dim {
+                            for c in 0..cols {
+                                let (mut hi, mut lo) = (0.0f64, 0.0f64);
+                                for i in 0..dim {
+                                    let (x, w) = (coef[(b, i)], weights[i * cols + c]);
+                                    let p = x * w;
+                                    let pe = x.mul_add(w, -p);
+                                    let s = hi + p;
+                                    let bb = s - hi;
+                                    lo += (hi - (s - bb)) + (p - bb) + pe;
+                                    hi = s;
+                                }
+                                cw[b * cols + c] = hi + lo;
+                            }
+                        }
+                        Kind::Poly { dim: *mult, mat, cw }
+                    }
                     [Root { re: p, im: 0.0, mult: m1 }, Root { re: q, im: 0.0, mult: m2 }]
                         if *p > 0.0 && *q == -*p && m1 == m2 =>
                     {
@@ -133,7 +158,7 @@ impl Combined {
                 // 1). The solve's series carry ~40 terms of margin (order 40: 82 … 106
                 // terms, none above 1e-17 after the 48th … 64th), which cost a point half
                 // its time.
-                let lens = mats
+                let lens: Vec<Vec<usize>> = mats
                     .iter()
                     .map(|m| {
                         m.chunks_exact(size)
@@ -184,10 +209,12 @@ impl Combined {
     }
 
     /// Chebyshev terms `T_m(2u − 1)` that [`eval`](Self::eval) reads (0 unless the
-    /// functions are Chebyshev series).
+    /// functions are Chebyshev series or polynomials in the Chebyshev basis).
     pub fn chebyshev_terms(&self) -> usize {
         match &self.kind {
             Kind::Cheb { size, .. } => *size,
+            // the basis itself, for values
+            Kind::Poly { dim, .. } => *dim,
             _ => 0,
         }
     }
@@ -254,8 +281,13 @@ impl Combined {
                 }
                 self.through_cardinals(dim, kmax, mat, scratch, out);
             }
-            Kind::Poly { dim, mat } => {
+            Kind::Poly { dim, mat, cw } => {
                 let dim = *dim;
+                if kmax == 0 && cheb.len() >= dim {
+                    // the caller's T_b(2u − 1): the recurrence below, the same numbers
+                    row_times(&cheb[..dim], cw, cols, &mut out[..cols]);
+                    return;
+                }
                 let x = 2.0 * u - 1.0;
                 // T_b^{(j)} = 2x T_{b−1}^{(j)} + 2j T_{b−1}^{(j−1)} − T_{b−2}^{(j)}, then d/du = 2 d/dx
                 for j in 0..=kmax {
@@ -280,7 +312,11 @@ impl Combined {
                         *s *= scale;
                     }
                 }
-                self.through_cardinals(dim, kmax, mat, scratch, out);
+                if kmax == 0 {
+                    row_times(&scratch[..dim], cw, cols, &mut out[..cols]);
+                } else {
+                    self.through_cardinals(dim, kmax, mat, scratch, out);
+                }
             }
             Kind::Cheb { size, mats, lens } => {
                 let size = *size;

@@ -233,3 +233,79 @@ fn grid_evaluation_matches_pointwise_derivatives() {
         }
     }
 }
+
+/// The closed form of [`exact`] with its data written as expressions (numbers for the mode
+/// functions' values and slopes at u = 0 and 1, times `cos nv`, `sin nv`): the data are
+/// proved finite Fourier series (degree 3 ≤ M = 4), so the tails are taken as exactly zero
+/// and the data are not evaluated; the patch still meets the closed form, and equals the
+/// same data given as opaque fields (whose tails are summed) to round-off.
+#[test]
+fn data_proved_finite_series_have_no_remainder() {
+    use crate::data::ExprField;
+    let a = 1.1f64;
+    let m = |u: f64| {
+        let (e2, e2p, e3) = ((-2.0 * a * u).exp(), (2.0 * a * (u - 1.0)).exp(), (3.0 * a * (u - 1.0)).exp());
+        let m0 = [1.0 + 0.5 * u - 0.8 * u.powi(3), 0.5 - 2.4 * u * u];
+        let m2 = [u * e2 + 0.3 * e2p, e2 - 2.0 * a * u * e2 + 0.6 * a * e2p];
+        let m3 = [(1.0 - u) * e3, -e3 + 3.0 * a * (1.0 - u) * e3];
+        (m0, m2, m3)
+    };
+    let expr_data = |u: f64, d: usize| -> FieldRef {
+        let (m0, m2, m3) = m(u);
+        let x = format!("{:?} + {:?}*cos(2*v)", m0[d], m2[d]);
+        let y = format!("{:?}*sin(3*v) - 0.5*{:?}*sin(2*v)", m3[d], m2[d]);
+        let z = format!("0.3*{:?} + {:?}*cos(3*v)", m0[d], m3[d]);
+        Arc::new(ExprField::parse([&x, &y, &z], &["v", "t"], &|_| None).unwrap())
+    };
+    let ends = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)];
+    let opts = SpectralOptions { a, modes: 4, omega: None };
+    let conds: Vec<Condition> = ends.iter().map(|&(u, d)| Condition { u, order: d, data: expr_data(u, d) }).collect();
+    let p = SpectralPatch::new(&conds, VDomain::PERIODIC, opts).unwrap();
+    assert!(p.exact_series);
+    assert!(p.tails(0.7, 2).iter().flatten().all(|t| *t == Vec3::ZERO));
+    let opaque: Vec<Condition> =
+        ends.iter().map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) }).collect();
+    let q = SpectralPatch::new(&opaque, VDomain::PERIODIC, opts).unwrap();
+    assert!(!q.exact_series);
+    let f = exact(a);
+    let (mut worst, mut apart): (f64, f64) = (0.0, 0.0);
+    for i in 0..=20 {
+        for j in 0..30 {
+            let (u, th) = (i as f64 / 20.0, j as f64 * 0.21);
+            let s = JetShape::scalar();
+            let want = f(&Jet::constant(s, u), &Jet::constant(s, th));
+            let got = p.derivatives(u, th, 1, 1);
+            for c in 0..3 {
+                worst = crate::num::max_nan(worst, (got[0][c] - want[c].value()).abs());
+            }
+            let other = q.derivatives(u, th, 1, 1);
+            for (x, y) in got.iter().zip(&other) {
+                apart = crate::num::max_nan(apart, (*x - *y).norm());
+            }
+        }
+    }
+    // as the closed-form test above (values ≤ 2: 1e-12 leaves room for the solve's
+    // conditioning), and the two data forms a few ulps apart in values and derivatives ≤ 10
+    assert!(worst < 1e-12, "max deviation from the closed form {worst:e}");
+    assert!(apart < 1e-13, "expression and opaque data differ by {apart:e}");
+
+    // not proved: an open patch (even extension), degree above M, data in t, not a series
+    let with = |x: &str| -> Vec<Condition> {
+        ends.iter()
+            .map(|&(u, d)| {
+                let data: FieldRef = Arc::new(ExprField::parse([x, "sin(v)", "1"], &["v", "t"], &|_| None).unwrap());
+                Condition { u, order: d, data }
+            })
+            .collect()
+    };
+    for (x, domain) in [
+        ("cos(v)", VDomain::open(0.0, 2.0)),
+        ("cos(5*v)", VDomain::PERIODIC),
+        ("t*cos(v)", VDomain::PERIODIC),
+        ("exp(sin(v))", VDomain::PERIODIC),
+    ] {
+        let r = SpectralPatch::new(&with(x), domain, opts).unwrap();
+        assert!(!r.exact_series, "{x}");
+    }
+    assert!(SpectralPatch::new(&with("cos(4*v)"), VDomain::PERIODIC, opts).unwrap().exact_series);
+}
