@@ -39,9 +39,6 @@ pub(super) const KMAX: usize = 1;
 pub(super) struct Folded {
     modes: Vec<Combined>,
     rem: Combined,
-    /// The data are finite Fourier series of at most M modes
-    /// ([`SpectralPatch::exact_series`](super::SpectralPatch)): no data, no remainder.
-    exact_series: bool,
     /// All the conditions' data in one tape, when they are expression fields in the same
     /// variables (at most `v, t`): what the sections share (`cos v`, `sin v`) is computed
     /// once per point, not once per section.
@@ -102,12 +99,7 @@ impl Folded {
             })
             .collect();
         let eye: Vec<f64> = (0..nc * nc).map(|k| f64::from(k / nc == k % nc)).collect();
-        Folded {
-            modes,
-            rem: Combined::new(&p.rem, eye, nc, KMAX),
-            joint: joint_tape(&p.data),
-            exact_series: p.exact_series,
-        }
+        Folded { modes, rem: Combined::new(&p.rem, eye, nc, KMAX), joint: joint_tape(&p.data) }
     }
 }
 
@@ -155,7 +147,7 @@ impl SpectralPatch {
         let scratch_len = f.modes.iter().map(Combined::scratch_len).chain([f.rem.scratch_len()]).max().unwrap_or(0);
         let mut scratch = vec![0.0; scratch_len];
         // T_m(2u − 1) once per point for every Chebyshev combination
-        let rem_terms = if f.exact_series { 0 } else { f.rem.chebyshev_terms() };
+        let rem_terms = if self.exact_series { 0 } else { f.rem.chebyshev_terms() };
         let terms = f.modes.iter().map(Combined::chebyshev_terms).chain([rem_terms]).max().unwrap_or(0);
         let mut cheb = vec![0.0; if terms > 0 { terms.max(2) } else { 0 }];
         let mut fold = vec![0.0; (imax + 1) * 6];
@@ -163,7 +155,8 @@ impl SpectralPatch {
         let mut cs = vec![(1.0, 0.0); m + 1];
         let mut tails = vec![Vec3::ZERO; nc * nj];
         let mut at = Vec::with_capacity(2 * BLOCK);
-        let mut g = vec![Vec3::ZERO; nc * BLOCK * nj];
+        // the data of a block (none when the series are exact: nothing reads them)
+        let mut g = vec![Vec3::ZERO; if self.exact_series { 0 } else { nc * BLOCK * nj }];
         let scale: [f64; 4] = std::array::from_fn(|j| self.dtheta_dv.powi(j as i32));
         for (pts, dst) in uv.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
             crate::cancel::checkpoint();
@@ -171,7 +164,7 @@ impl SpectralPatch {
             at.clear();
             at.extend(pts.iter().flat_map(|p| [self.theta(p[1]), self.time]));
             match (&f.joint, nj) {
-                _ if f.exact_series => {}
+                _ if self.exact_series => {}
                 (Some(tape), 1) => {
                     let mut regs = Vec::new();
                     for (k, p) in at.chunks_exact(2).enumerate() {
@@ -237,7 +230,7 @@ impl SpectralPatch {
                         acc[d] += (av * c + bv * s) * npow(n, j);
                     }
                 }
-                if f.exact_series {
+                if self.exact_series {
                     for (d, &(_, j)) in orders.iter().enumerate() {
                         o[d] = acc[d] * if j < 4 { scale[j] } else { self.dtheta_dv.powi(j as i32) };
                     }
