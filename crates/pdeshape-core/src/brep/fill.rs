@@ -14,7 +14,7 @@
 //! four pieces at equal parameter steps; the cuts are not corners of the neighbours (one
 //! face on both sides), so the fill is G1 there like anywhere along the edge.
 
-use super::{Brep, Hole, HoleKind};
+use super::{Brep, Hole, HoleKind, HoleUse};
 use crate::fill::{AlongCurve, DomainCurve, Fill, FillEdge, FillError, FillOptions, FootCurve, FootError, Host};
 use crate::num::max_nan;
 use std::sync::Arc;
@@ -59,39 +59,74 @@ pub fn fill_hole(b: &Brep, hole: &Hole, options: &FillOptions) -> Result<HoleFil
     if hole.kind != HoleKind::Simple {
         return Err(HoleFillError::NotSimple(hole.kind));
     }
-    let n = hole.uses.len();
-    let cuts = match n {
-        1 => 3,
-        2 => 2,
-        _ => 1,
-    };
+    fill_uses(b, &hole.uses, options)
+}
+
+/// Fills the loop of edges `uses` of `b` (each run as its face runs it, each ending where
+/// the next starts, the last where the first starts) with `options`: what [`fill_hole`]
+/// does for a hole, for any closed chain of edges a caller names.
+pub fn fill_uses(b: &Brep, uses: &[HoleUse], options: &FillOptions) -> Result<HoleFill, HoleFillError> {
+    let cuts = pieces_per_edge(uses.len());
     let mut pieces = Vec::new();
     let mut edges = Vec::new();
     let mut edge_offset: f64 = 0.0;
-    for (k, u) in hole.uses.iter().enumerate() {
-        let e = &b.edges[u.edge];
-        let f = &b.faces[u.face];
-        let (a, z) = if u.forward { e.range } else { (e.range.1, e.range.0) };
-        let (Some(surface), Some(ec)) = (&f.surface, &e.curve) else {
-            let what = if f.surface.is_none() { format!("face #{}", f.id) } else { format!("edge #{}", e.id) };
-            return Err(HoleFillError::Unsupported(what));
-        };
-        let host = surface.field();
-        let curve = ec.field();
-        for c in 0..cuts {
-            let ta = a + (z - a) * c as f64 / cuts as f64;
-            let tb = a + (z - a) * (c + 1) as f64 / cuts as f64;
-            let start = surface.invert_near(curve.eval(&[ta]));
-            let foot = FootCurve::new(host.clone(), curve.clone(), (ta, tb), start, options.t)
-                .map_err(|err| HoleFillError::Foot { edge: e.id, face: f.id, err })?;
-            edge_offset = max_nan(edge_offset, foot.max_distance());
-            let dir = if tb >= ta { 1.0 } else { -1.0 };
-            let side = if f.same_sense { -dir } else { dir };
-            let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(Arc::new(foot)) };
-            edges.push(FillEdge { surface: Arc::new(along), s0: 0.0, w: (ta, tb), fullness: 1.0, side: Some(side) });
-            pieces.push((k, (ta, tb)));
-        }
+    for (k, u) in uses.iter().enumerate() {
+        let p = edge_pieces(b, u, cuts, options.t)?;
+        edge_offset = max_nan(edge_offset, p.offset);
+        pieces.extend(p.ranges.into_iter().map(|r| (k, r)));
+        edges.extend(p.edges);
     }
     let fill = Fill::new(&edges, options)?;
     Ok(HoleFill { fill, pieces, edge_offset })
+}
+
+/// Into how many fill edges each edge of a loop of `n` edges is cut: a loop of fewer than
+/// three edges is cut into three or four pieces (module docs).
+pub fn pieces_per_edge(n: usize) -> usize {
+    match n {
+        1 => 3,
+        2 => 2,
+        _ => 1,
+    }
+}
+
+/// An edge of a B-rep as fill edges on its face.
+pub struct EdgePieces {
+    /// The fill edges, in the order the face runs the edge (cross tangent away from the
+    /// face, fullness 1).
+    pub edges: Vec<FillEdge>,
+    /// Each piece's range of the edge curve's parameter, as run.
+    pub ranges: Vec<(f64, f64)>,
+    /// The largest distance between the edge's curve and its foot on the face.
+    pub offset: f64,
+}
+
+/// The edge of `u`, run as its face runs it, cut into `cuts` fill edges of equal
+/// parameter steps on the face's surface reparametrised around the edge's foot curve (at
+/// time `t`).
+pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePieces, HoleFillError> {
+    let e = &b.edges[u.edge];
+    let f = &b.faces[u.face];
+    let (a, z) = if u.forward { e.range } else { (e.range.1, e.range.0) };
+    let (Some(surface), Some(ec)) = (&f.surface, &e.curve) else {
+        let what = if f.surface.is_none() { format!("face #{}", f.id) } else { format!("edge #{}", e.id) };
+        return Err(HoleFillError::Unsupported(what));
+    };
+    let host = surface.field();
+    let curve = ec.field();
+    let mut out = EdgePieces { edges: Vec::new(), ranges: Vec::new(), offset: 0.0 };
+    for c in 0..cuts {
+        let ta = a + (z - a) * c as f64 / cuts as f64;
+        let tb = a + (z - a) * (c + 1) as f64 / cuts as f64;
+        let start = surface.invert_near(curve.eval(&[ta]));
+        let foot = FootCurve::new(host.clone(), curve.clone(), (ta, tb), start, t)
+            .map_err(|err| HoleFillError::Foot { edge: e.id, face: f.id, err })?;
+        out.offset = max_nan(out.offset, foot.max_distance());
+        let dir = if tb >= ta { 1.0 } else { -1.0 };
+        let side = if f.same_sense { -dir } else { dir };
+        let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(Arc::new(foot)) };
+        out.edges.push(FillEdge { surface: Arc::new(along), s0: 0.0, w: (ta, tb), fullness: 1.0, side: Some(side) });
+        out.ranges.push((ta, tb));
+    }
+    Ok(out)
 }

@@ -16,7 +16,7 @@ use crate::data::{Field, FieldRef, NurbsCurve, NurbsSurface};
 use crate::jet::JetShape;
 use std::sync::Arc;
 
-pub use fill::{HoleFill, HoleFillError, fill_hole};
+pub use fill::{EdgePieces, HoleFill, HoleFillError, edge_pieces, fill_hole, fill_uses, pieces_per_edge};
 pub use holes::{Corner, Hole, HoleKind, HoleUse, holes};
 
 /// A face's surface.
@@ -174,6 +174,22 @@ pub struct Brep {
 }
 
 impl Brep {
+    /// How the faces' loops run the edge `edge` (index into [`Brep::edges`]): one use per
+    /// loop that names it, in the order of the faces.
+    pub fn uses_of(&self, edge: usize) -> Vec<HoleUse> {
+        let mut out = Vec::new();
+        for (face, f) in self.faces.iter().enumerate() {
+            for l in &f.loops {
+                for &(e, forward) in l {
+                    if e == edge {
+                        out.push(HoleUse { edge, forward, face });
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The diagonal of the bounding box of the vertices and of the edges' points (33 per
     /// edge): the model's size, to which tolerances are relative.
     pub fn size(&self) -> f64 {
