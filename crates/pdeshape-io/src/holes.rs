@@ -7,12 +7,13 @@
 use crate::export::{SewnFace, sewn_step, write_atomic};
 use crate::import::step::StepModel;
 use pdeshape_core::Vec3;
-use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleFill, HoleKind, fill_hole};
-use pdeshape_core::fill::{FillOptions, foot_of};
+use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleKind, fill_hole};
+use pdeshape_core::fill::{Fill, FillOptions, foot_of};
 use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_surface};
 use pdeshape_core::num::max_nan;
 use serde::Serialize;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Corners whose faces' normals differ by more than this are reported as not G1 (as
 /// `check` judges a fill's corners).
@@ -119,7 +120,12 @@ pub struct FilledHole {
     /// The hole's number (from 1).
     pub index: usize,
     /// The fill.
-    pub fill: HoleFill,
+    pub fill: Arc<Fill>,
+    /// The order of its PDE (4: G1, 6: G2).
+    pub order: usize,
+    /// The largest distance between the hole's edge curves and their faces (as the file
+    /// has them).
+    pub edge_offset: f64,
     /// Its B-spline face.
     pub surface: BSplineSurface,
     /// The fit.
@@ -245,28 +251,43 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
             .filter(|&i| o.max_edges.is_none_or(|n| holes[i].uses.len() <= n))
             .collect(),
     };
-    let size = m.brep.size();
     let mut out = Vec::with_capacity(chosen.len());
     for i in chosen {
-        let h = &holes[i];
-        let fail = |e: String| format!("hole {}: {e}", i + 1);
         let opts = FillOptions { order: o.order, ..Default::default() };
-        let fill = fill_hole(&m.brep, h, &opts).map_err(|e| fail(e.to_string()))?;
-        let degree = if o.order == 6 { 5 } else { 3 };
-        let fo = FitOptions {
-            tolerance: Some(o.relative * size),
-            degree,
-            v_breaks: fill.fill.corner_parameters(),
-            ..Default::default()
-        };
-        let (surface, fit) = fit_surface(fill.fill.patch().as_ref(), &fo).map_err(|e| fail(e.to_string()))?;
-        if !fit.max_deviation.is_finite() {
-            return Err(fail(format!("the fit's measured deviation {} is not finite", fit.max_deviation)));
-        }
-        let seam = measure_seam(&m.brep, &h.faces(), &surface, 400, size);
-        out.push(FilledHole { index: i + 1, fill, surface, fit, seam });
+        let fill = fill_hole(&m.brep, &holes[i], &opts).map_err(|e| format!("hole {}: {e}", i + 1))?;
+        out.push(fit_filled(m, holes, i + 1, Arc::new(fill.fill), o.order, fill.edge_offset, o.relative)?);
     }
     Ok(out)
+}
+
+/// Fits the fill `fill` (of order `order`) of hole `index` (from 1) of `m` by a B-spline
+/// face of degree 3 (order 4) or 5 (order 6) to `relative` of the model's size, and
+/// measures the seam of the face against the faces around.
+pub fn fit_filled(
+    m: &StepModel,
+    holes: &[Hole],
+    index: usize,
+    fill: Arc<Fill>,
+    order: usize,
+    edge_offset: f64,
+    relative: f64,
+) -> Result<FilledHole, String> {
+    let fail = |e: String| format!("hole {index}: {e}");
+    let h = holes.get(index.wrapping_sub(1)).ok_or_else(|| fail("no such hole".into()))?;
+    let size = m.brep.size();
+    let degree = if order == 6 { 5 } else { 3 };
+    let fo = FitOptions {
+        tolerance: Some(relative * size),
+        degree,
+        v_breaks: fill.corner_parameters(),
+        ..Default::default()
+    };
+    let (surface, fit) = fit_surface(fill.patch().as_ref(), &fo).map_err(|e| fail(e.to_string()))?;
+    if !fit.max_deviation.is_finite() {
+        return Err(fail(format!("the fit's measured deviation {} is not finite", fit.max_deviation)));
+    }
+    let seam = measure_seam(&m.brep, &h.faces(), &surface, 400, size);
+    Ok(FilledHole { index, fill, order, edge_offset, surface, fit, seam })
 }
 
 /// Writes `m` with the filled holes sewn in to `out` (atomically).
@@ -288,8 +309,55 @@ pub fn write_filled(m: &StepModel, holes: &[Hole], filled: &[FilledHole], out: &
         .collect();
     // the new faces' corners meet the hole's vertices within the fit's tolerance and the
     // file's edges' offset from their faces
-    let edge_offset = filled.iter().fold(0.0, |a, f| max_nan(a, f.fill.edge_offset));
+    let edge_offset = filled.iter().fold(0.0, |a, f| max_nan(a, f.edge_offset));
     let tol = 10.0 * (1e-7 * size + edge_offset);
     let bytes = sewn_step(m, &faces, tol)?;
     write_atomic(out, |w| w.write_all(&bytes)).map_err(|e| format!("{}: {e}", out.display()))
+}
+
+/// The fills of a scene that imports a model, fitted for [`write_filled`]: every patch must
+/// fill a hole of one imported model (`hole = "MODEL.holeK"`, or `edges` that are exactly a
+/// hole's), each hole once. Fitted as `fill-holes` fits (to `relative` of the model's size).
+pub fn scene_fills(
+    sc: &crate::scene::Scene,
+    relative: f64,
+) -> Result<(Arc<crate::scene::ImportedModel>, Vec<FilledHole>), String> {
+    let Some(first) = sc.imports.first() else {
+        return Err(format!("the scene {} imports no model", sc.file));
+    };
+    let mut import = None;
+    let mut out: Vec<FilledHole> = Vec::new();
+    for p in &sc.patches {
+        let (Some(h), Some(fill)) = (&p.hole, &p.fill) else {
+            return Err(format!(
+                "patch `{}` does not fill a hole of the imported model: a STEP file of a scene that imports a model is that model with the fills of its holes sewn in (use a mesh format for other patches)",
+                p.name
+            ));
+        };
+        let imp = sc.imports.iter().find(|i| i.name == h.import).unwrap_or(first);
+        if *import.get_or_insert(&imp.name) != &imp.name {
+            return Err(format!(
+                "patch `{}` fills a hole of `{}`, another patch one of `{}`: one model is written back at a time",
+                p.name,
+                imp.name,
+                import.map_or("", |s| s.as_str())
+            ));
+        }
+        if let Some(other) = out.iter().position(|f| f.index == h.hole) {
+            return Err(format!(
+                "patches `{}` and `{}` fill the same hole {}.hole{}",
+                sc.patches[other].name, p.name, imp.name, h.hole
+            ));
+        }
+        let m = &imp.model;
+        let f = fit_filled(&m.model, &m.holes, h.hole, fill.clone(), h.order, h.edge_offset, relative)
+            .map_err(|e| format!("patch `{}`: {e}", p.name))?;
+        out.push(f);
+    }
+    if out.is_empty() {
+        return Err(format!("the scene {} has no fills to sew into its imported model", sc.file));
+    }
+    let name = import.unwrap_or(&first.name);
+    let model = sc.imports.iter().find(|i| i.name == *name).map_or(first.model.clone(), |i| i.model.clone());
+    Ok((model, out))
 }

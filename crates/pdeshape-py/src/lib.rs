@@ -15,7 +15,7 @@ use pdeshape_core::patch::Surface;
 use pdeshape_io::export::{Format, write_atomic, write_meshes};
 use pdeshape_io::model;
 use pdeshape_io::sample::{Target, points_into};
-use pdeshape_io::scene::{LoadOptions, Scene as IoScene, SceneError as IoSceneError, ScenePatch};
+use pdeshape_io::scene::{ImportRoot, LoadOptions, Scene as IoScene, SceneError as IoSceneError, ScenePatch};
 use pyo3::exceptions::{
     PyException, PyKeyError, PyMemoryError, PyRuntimeError, PyTimeoutError, PyTypeError, PyValueError,
 };
@@ -273,14 +273,17 @@ impl Scene {
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
         let time_limit = self::time_limit(time_limit)?;
-        let opts = Scene::options(solver, terms, limits, params)?;
+        let mut opts = Scene::options(solver, terms, limits, params)?;
+        opts.imports = import_folder(&pdeshape_io::scene::scene_folder(&path))?;
         let text = pdeshape_io::scene::read_scene_file(&path, &opts.limits).map_err(scene_error)?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
         Scene::build(&text, &path.display().to_string(), &name, opts, time_limit, py)
     }
 
     /// Parses and solves scene text (TOML); `name` labels errors and exports. The text is
-    /// held to the `scene` cap as files are (16 MiB unless `limits` says otherwise).
+    /// held to the `scene` cap as files are (16 MiB unless `limits` says otherwise). Its
+    /// `[import.*]` paths are relative to the current directory (`Scene.load`: to the scene
+    /// file's folder).
     #[staticmethod]
     #[pyo3(signature = (text, name="scene", *, solver=None, terms=None, limits=None, time_limit=None, **params))]
     #[allow(clippy::too_many_arguments)]
@@ -295,7 +298,8 @@ impl Scene {
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
         let time_limit = self::time_limit(time_limit)?;
-        let opts = Scene::options(solver, terms, limits, params)?;
+        let mut opts = Scene::options(solver, terms, limits, params)?;
+        opts.imports = import_folder(std::path::Path::new("."))?;
         opts.limits
             .check(Cap::Scene, (text.len() as u128).div_ceil(1 << 20), "the scene text's size")
             .map_err(|e| SceneError::new_err(py_message(&format!("{name}: {e}"))))?;
@@ -406,7 +410,16 @@ impl Scene {
     }
 }
 
-/// What a pickled scene holds: a dict of its text, labels and load options.
+/// The folder `[import.*]` paths are read from, made absolute, so that a pickled scene
+/// imports the same files in a worker whose current directory differs.
+fn import_folder(folder: &std::path::Path) -> PyResult<ImportRoot> {
+    std::path::absolute(folder)
+        .map(ImportRoot::Dir)
+        .map_err(|e| PyValueError::new_err(format!("{}: {e}", folder.display())))
+}
+
+/// What a pickled scene holds: a dict of its text, labels, load options and the folder its
+/// imports are read from (the workers that unpickle it read the same paths).
 fn scene_state<'py>(py: Python<'py>, s: &IoScene, time_limit: f64) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("text", &s.source)?;
@@ -425,6 +438,9 @@ fn scene_state<'py>(py: Python<'py>, s: &IoScene, time_limit: f64) -> PyResult<B
     }
     d.set_item("limits", limits)?;
     d.set_item("time_limit", time_limit)?;
+    if let ImportRoot::Dir(folder) = &s.options.imports {
+        d.set_item("imports", folder)?;
+    }
     Ok(d)
 }
 
@@ -446,6 +462,10 @@ fn _scene_from_state(py: Python<'_>, state: &Bound<'_, PyDict>) -> PyResult<Scen
         Some(params.cast::<PyDict>()?),
     )?;
     let time_limit = self::time_limit(get("time_limit")?.extract()?)?;
+    let mut opts = opts;
+    if let Some(folder) = state.get_item("imports")? {
+        opts.imports = ImportRoot::Dir(folder.extract()?);
+    }
     Scene::build(&text, &file, &name, opts, time_limit, py)
 }
 

@@ -45,6 +45,9 @@ pub fn command(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Resul
             "--tolerance, --relative-tolerance and --degree apply to STEP output only (-o FILE.step)",
         ));
     }
+    if (ext == "step" || ext == "stp") && !sc.imports.is_empty() {
+        return imported_step(sc, out, step, quiet);
+    }
     if ext == "step" || ext == "stp" {
         if sc.patches.is_empty() {
             bail!("the scene {} has no patches to write", sc.file);
@@ -190,4 +193,31 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
         written.push(to);
     }
     Ok(written)
+}
+
+/// `build -o OUT.step` of a scene that imports a model: the model written back exactly with
+/// the scene's fills of its holes sewn in, fitted as `fill-holes` fits them (the fill's
+/// order sets the degree: 3 for order 4, 5 for order 6).
+fn imported_step(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Result<()> {
+    if step.degree.is_some() {
+        return Err(crate::usage::usage(
+            "--degree does not apply to a scene that imports a model: each fill's order sets its face's degree (3 for order 4, 5 for order 6)",
+        ));
+    }
+    let defaults = pdeshape_io::holes::FillHolesOptions::default();
+    let size = sc.imports.first().map_or(1.0, |i| i.model.model.brep.size());
+    let relative = match (step.tolerance, step.relative_tolerance) {
+        (Some(t), _) => t / size,
+        (None, Some(r)) => r,
+        (None, None) => defaults.relative,
+    };
+    let (m, filled) = pdeshape_io::holes::scene_fills(sc, relative).map_err(|e| anyhow!("{}: {e}", sc.file))?;
+    pdeshape_io::holes::write_filled(&m.model, &m.holes, &filled, out).map_err(|e| anyhow!(e))?;
+    if !quiet {
+        for line in crate::holes::filled_lines(&filled) {
+            eprintln!("{line}");
+        }
+        eprintln!("wrote {} ({} with {} new face(s))", out.display(), m.path.display(), filled.len());
+    }
+    Ok(())
 }

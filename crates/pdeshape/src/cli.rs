@@ -388,6 +388,7 @@ impl Load<'_> {
             solver: self.solver.map(str::to_string),
             terms: self.terms,
             limits: self.limits,
+            imports: pdeshape_io::scene::ImportRoot::Dir(pdeshape_io::scene::scene_folder(path)),
         };
         let scene = Scene::parse_with(&text, &path.display().to_string(), &name, &opts)?;
         let _ = LOADED.set(Solves::now());

@@ -6,7 +6,7 @@ use anyhow::{Result, anyhow};
 use pdeshape_core::brep::holes;
 use pdeshape_core::limits::Limits;
 use pdeshape_core::trimesh::{MeshLoop, boundary};
-use pdeshape_io::holes::{FillHolesOptions, fill_holes, holes_report, write_filled};
+use pdeshape_io::holes::{FillHolesOptions, FilledHole, fill_holes, holes_report, write_filled};
 use pdeshape_io::import::mesh::{MeshFile, MeshFormat, read_mesh};
 use pdeshape_io::import::step::{StepModel, read_step};
 use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, mesh_view, render_trimesh, write_trimesh};
@@ -107,21 +107,31 @@ pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quie
         for h in r.holes.iter().filter(|h| !filled.iter().any(|f| f.index == h.index)) {
             eprintln!("hole {}: left open ({}, {} edge(s))", h.index, h.kind, h.edges.len());
         }
-        for f in &filled {
-            let s = &f.seam;
-            let g2 = if o.order == 6 {
-                format!(", curvature gap {:.3e} (relative {:.3e})", s.curvature_gap, s.relative_curvature_gap)
-            } else {
-                String::new()
-            };
-            eprintln!(
-                "hole {}: order {}, {} × {} control points, measured deviation {:.3e}; seam gap {:.3e}, G1 {:.3e} rad{g2} ({} points)",
-                f.index, o.order, f.fit.points.0, f.fit.points.1, f.fit.max_deviation, s.gap, s.angle, s.samples
-            );
+        for line in filled_lines(&filled) {
+            eprintln!("{line}");
         }
         eprintln!("wrote {}", out.display());
     }
     Ok(())
+}
+
+/// A line per filled hole: its fit and the seam measured on the written face.
+pub fn filled_lines(filled: &[FilledHole]) -> Vec<String> {
+    filled
+        .iter()
+        .map(|f| {
+            let s = &f.seam;
+            let g2 = if f.order == 6 {
+                format!(", curvature gap {:.3e} (relative {:.3e})", s.curvature_gap, s.relative_curvature_gap)
+            } else {
+                String::new()
+            };
+            format!(
+                "hole {}: order {}, {} × {} control points, measured deviation {:.3e}; seam gap {:.3e}, G1 {:.3e} rad{g2} ({} points)",
+                f.index, f.order, f.fit.points.0, f.fit.points.1, f.fit.max_deviation, s.gap, s.angle, s.samples
+            )
+        })
+        .collect()
 }
 
 fn read_checked(path: &Path, limits: &Limits) -> Result<(MeshFile, Vec<MeshLoop>)> {

@@ -270,3 +270,62 @@ fn holes_not_asked_for_stay_open() {
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.contains("OPEN_SHELL") && !text.contains("CLOSED_SHELL") && !text.contains("MANIFOLD_SOLID_BREP"));
 }
+
+/// A scene that imports the rounded box and fills two of its corners — one by
+/// `hole = "box.hole1"`, one by its three edges — builds to the same bytes as `fill-holes`
+/// on those holes (order 4, both): the model written back, the fills fitted and sewn in
+/// alike.
+#[test]
+fn a_scene_importing_a_model_builds_it_back_with_its_fills() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = model("rounded-box-corners.step");
+    let scene = d.join("corners.toml");
+    let text = format!(
+        "[import.box]\nstep = {:?}\n\n[patches.c1]\nkind = \"fill\"\nhole = \"box.hole1\"\n\n[patches.c2]\nkind = \"fill\"\nedges = [{{ edge = \"box.edge187\" }}, {{ edge = \"box.edge267\" }}, {{ edge = \"box.edge750\" }}]\n",
+        input.to_str().unwrap()
+    );
+    std::fs::write(&scene, &text).unwrap();
+    let (a, b) = (d.join("scene.step"), d.join("fill-holes.step"));
+    let o = run(&["build", scene.to_str().unwrap(), "-o", a.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(figures(&err).len(), 2, "{err}");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", b.to_str().unwrap(), "--order", "4", "--holes", "1,2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(), "the two files differ");
+    let left: Vec<u64> =
+        json(&a)["holes"].as_array().unwrap().iter().map(|h| h["edges"][0].as_u64().unwrap()).collect();
+    assert_eq!(left.len(), 6, "{left:?}");
+
+    // the scene's relative import path is read from the scene file's folder, from anywhere
+    std::fs::copy(&input, d.join("box.step")).unwrap();
+    std::fs::write(&scene, text.replace(&format!("{:?}", input.to_str().unwrap()), "\"box.step\"")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_pdeshape"))
+        .args(["build", "-q", scene.to_str().unwrap(), "-o", "m.ply"])
+        .current_dir(std::env::temp_dir())
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_file(std::env::temp_dir().join("m.ply"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // what a STEP build of an imported model refuses, writing nothing
+    let c = d.join("c.step");
+    refused(&["build", scene.to_str().unwrap(), "-o", c.to_str().unwrap(), "--degree", "5"], 2, &["--degree", "order"]);
+    let mixed = d.join("mixed.toml");
+    let extra = "\n[curves.a]\nexpr = [\"cos(v)\", \"sin(v)\", \"0\"]\n[curves.b]\nexpr = [\"cos(v)\", \"sin(v)\", \"1\"]\n[patches.tube]\nkind = \"hermite\"\nconditions = [{ u = 0, curve = \"a\" }, { u = 1, curve = \"b\" }]\n";
+    std::fs::write(&mixed, std::fs::read_to_string(&scene).unwrap() + extra).unwrap();
+    refused(&["build", mixed.to_str().unwrap(), "-o", c.to_str().unwrap()], 1, &["patch `tube` does not fill a hole"]);
+    let twice = d.join("twice.toml");
+    std::fs::write(
+        &twice,
+        std::fs::read_to_string(&scene).unwrap().replace("hole = \"box.hole1\"", "hole = \"box.hole2\""),
+    )
+    .unwrap();
+    refused(
+        &["build", twice.to_str().unwrap(), "-o", c.to_str().unwrap()],
+        1,
+        &["patches `c1` and `c2` fill the same hole box.hole2"],
+    );
+    assert!(!c.exists());
+}

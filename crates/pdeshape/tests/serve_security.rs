@@ -3,6 +3,7 @@
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 mod common;
@@ -407,4 +408,35 @@ fn body_size_vertex_count_and_loopback_names() {
     let v6 = format!("[::1]:{port}");
     assert_eq!(request(&addr, "GET", "/api/examples", &[("Host", &v6)], b"").status, 200);
     assert_eq!(request(&addr, "GET", "/api/examples", &[("Host", "[::1]")], b"").status, 421);
+}
+
+/// A request's scene text comes from a web page: its `[import.*]` may name only the models
+/// the editor's own scene imported at start (by the path as that scene wrote it), never
+/// another file, whose bytes (or whether it exists) would otherwise leak into the answer.
+#[test]
+fn requests_import_only_what_the_editors_scene_imported() {
+    let dir = tempfile::tempdir().unwrap();
+    let step = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/step/cylinder-open.step");
+    std::fs::copy(&step, dir.path().join("part.step")).unwrap();
+    let own = "[import.part]\nstep = \"part.step\"\n\n[patches.top]\nkind = \"fill\"\nhole = \"part.hole1\"\n";
+    let scene_file = dir.path().join("top.toml");
+    std::fs::write(&scene_file, own).unwrap();
+
+    // no scene at start: nothing may be imported
+    let (_k, addr) = start(&[]);
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": own}));
+    assert_eq!(a.status, 422, "{}", a.text());
+    assert!(a.text().contains("not read from a file"), "{}", a.text());
+
+    // its own scene's import is served; any other path is refused without being read
+    let (_k2, addr) = start(&[scene_file.to_str().unwrap()]);
+    let a = post_json(&addr, "/api/model", &serde_json::json!({"text": own}));
+    assert_eq!(a.status, 200, "{}", a.text());
+    for path in ["/etc/passwd", "../part.step", step.to_str().unwrap()] {
+        let text = own.replace("part.step", path);
+        let a = post_json(&addr, "/api/model", &serde_json::json!({"text": text}));
+        assert_eq!(a.status, 422, "{path}: {}", a.text());
+        assert!(a.text().contains("only the models the scene imported"), "{path}: {}", a.text());
+        assert!(!a.text().contains("root:"), "{path}: {}", a.text());
+    }
 }

@@ -543,7 +543,7 @@ pub fn study_strip(scene: &Scene, study: &crate::scene::Study) -> Result<Image, 
         let mut over: std::collections::HashMap<String, f64> = study.set.iter().cloned().collect();
         over.insert(study.vary.clone(), x);
         // the scene's own caps, solver and terms; the study's parameters
-        let opts = crate::scene::LoadOptions { params: over, ..scene.options.clone() };
+        let opts = crate::scene::LoadOptions { params: over, imports: scene.imported(), ..scene.options.clone() };
         let sc = Scene::parse_with(&scene.source, &scene.file, &scene.name, &opts).map_err(|e| e.to_string())?;
         let t0 = sc.patches.iter().find_map(|p| p.dynamic.as_ref().map(|d| d.times.0)).unwrap_or(0.0);
         let patches = patch_meshes(&sc)?;

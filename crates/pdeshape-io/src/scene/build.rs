@@ -410,7 +410,14 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
             src.error(None, "--solver", format!("unknown solver `{w}` (known: auto, exact, collocation)"))
         })?),
     };
-    let mut ctx = Ctx { src: src.clone(), params: IndexMap::new(), solver, terms: opts.terms, limits: opts.limits };
+    let mut ctx = Ctx {
+        src: src.clone(),
+        params: IndexMap::new(),
+        solver,
+        terms: opts.terms,
+        limits: opts.limits,
+        imports: Vec::new(),
+    };
     let mut taken: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.parameters {
         check_name(&src, n, span(p), &format!("parameters.{n}"), &mut taken)?;
@@ -421,11 +428,15 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
     for (n, s) in &raw.surfaces {
         check_name(&src, n, span(s), &format!("surfaces.{n}"), &mut taken)?;
     }
+    for (n, i) in &raw.import {
+        check_name(&src, n, span(i), &format!("import.{n}"), &mut taken)?;
+    }
     let mut patch_names: HashMap<String, String> = HashMap::new();
     for (n, p) in &raw.patches {
         check_name(&src, n, span(p), &format!("patches.{n}"), &mut patch_names)?;
     }
     build_params(&mut ctx, &raw.parameters, overrides)?;
+    ctx.imports = super::import::read_imports(&ctx, &raw.import, &opts.imports)?;
 
     let mut surfaces = Vec::new();
     for (n, s) in &raw.surfaces {
@@ -463,6 +474,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
         let resolution = ctx.resolution(&rs.resolution, (17, 65), &format!("{key}.resolution"))?;
         surfaces.push(SceneSurface { name: n.clone(), field, s_range, domain, resolution });
     }
+    surfaces.extend(super::import::import_surfaces(&ctx.imports));
 
     let mut cb =
         CurveBuilder { ctx: &ctx, raw: &raw.curves, surfaces: &surfaces, done: IndexMap::new(), busy: Vec::new() };
@@ -554,6 +566,7 @@ pub(super) fn build(src: Source, name: &str, opts: &super::LoadOptions) -> R<Sce
         description: raw.scene.description,
         reference: raw.scene.reference,
         params: ctx.params,
+        imports: ctx.imports,
         curves,
         surfaces,
         patches,

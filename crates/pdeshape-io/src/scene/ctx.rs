@@ -31,6 +31,8 @@ pub(in crate::scene) struct Ctx<'a> {
     pub(in crate::scene) terms: Option<usize>,
     /// Caps on sizes.
     pub(in crate::scene) limits: Limits,
+    /// The models of `[import.*]`, read.
+    pub(in crate::scene) imports: Vec<crate::scene::SceneImport>,
 }
 
 pub(in crate::scene) fn span<T>(s: &Spanned<T>) -> Option<Range<usize>> {
@@ -46,16 +48,16 @@ pub(in crate::scene) fn find_surface<'s>(
     key: &str,
 ) -> R<&'s SceneSurface> {
     surfaces.iter().find(|s| s.name == *name.get_ref()).ok_or_else(|| {
-        let known: Vec<&str> = surfaces.iter().map(|s| s.name.as_str()).collect();
-        ctx.err(
-            span(name),
-            key,
-            format!(
-                "unknown surface `{}` (defined: {})",
-                name.get_ref(),
-                if known.is_empty() { "none".to_string() } else { known.join(", ") }
-            ),
-        )
+        // a model's faces may number thousands: the first few, and how many more
+        const SHOWN: usize = 24;
+        let known: Vec<&str> = surfaces.iter().take(SHOWN).map(|s| s.name.as_str()).collect();
+        let more = surfaces.len().saturating_sub(SHOWN);
+        let list = match (known.is_empty(), more) {
+            (true, _) => "none".to_string(),
+            (false, 0) => known.join(", "),
+            (false, m) => format!("{} and {m} more", known.join(", ")),
+        };
+        ctx.err(span(name), key, format!("unknown surface `{}` (defined: {list})", name.get_ref()))
     })
 }
 

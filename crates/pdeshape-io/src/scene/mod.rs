@@ -12,6 +12,7 @@ mod build;
 mod ctx;
 pub mod edit;
 mod error;
+mod import;
 mod kinds;
 mod nurbs;
 mod raw;
@@ -20,6 +21,7 @@ mod trim;
 
 pub use ctx::RESERVED;
 pub use error::{SceneError, Source};
+pub use import::{ImportRoot, ImportedModel, SceneImport};
 
 use indexmap::IndexMap;
 use pdeshape_core::data::FieldRef;
@@ -72,6 +74,8 @@ pub struct LoadOptions {
     pub terms: Option<usize>,
     /// Caps on order, modes, collocation size, resolution and memory.
     pub limits: pdeshape_core::limits::Limits,
+    /// Where `[import.*]` models are read from (default: nowhere).
+    pub imports: ImportRoot,
 }
 
 /// What a patch is (serialised by its name in scene files).
@@ -133,6 +137,22 @@ pub struct ScenePatch {
     pub trim: Option<TrimSetup>,
     /// Fills: the solved fill (its report, edge continuity, folds).
     pub fill: Option<Arc<pdeshape_core::fill::Fill>>,
+    /// Fills whose loop is a hole of an imported model: which (`build -o OUT.step` sews
+    /// the fill into that model).
+    pub hole: Option<PatchHole>,
+}
+
+/// The hole of an imported model a fill closes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchHole {
+    /// The import's name (`[import.NAME]`).
+    pub import: String,
+    /// The hole's number (from 1, as `holes` numbers them).
+    pub hole: usize,
+    /// The fill's order (4: G1, 6: G2).
+    pub order: usize,
+    /// The largest distance between the hole's edge curves and their faces.
+    pub edge_offset: f64,
 }
 
 impl ScenePatch {
@@ -369,6 +389,8 @@ pub struct Scene {
     pub reference: Option<String>,
     /// Parameters in file order.
     pub params: IndexMap<String, Param>,
+    /// `[import.*]`: the CAD models read, in file order.
+    pub imports: Vec<SceneImport>,
     /// Named curves.
     pub curves: IndexMap<String, FieldRef>,
     /// Primary surfaces.
@@ -422,13 +444,28 @@ pub fn read_scene_file(path: &Path, limits: &pdeshape_core::limits::Limits) -> R
     })
 }
 
+/// The folder a scene file's imports are relative to (`.` for a bare file name).
+pub fn scene_folder(path: &Path) -> std::path::PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    }
+}
+
 impl Scene {
-    /// Loads a scene file.
+    /// Loads a scene file (its imports relative to its folder).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
         let text = read_scene_file(path, &pdeshape_core::limits::Limits::default())?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-        Scene::parse(&text, &file, &name, &HashMap::new())
+        let opts = LoadOptions { imports: ImportRoot::Dir(scene_folder(path)), ..Default::default() };
+        Scene::parse_with(&text, &file, &name, &opts)
+    }
+
+    /// The models this scene imported, by the path as it wrote them: what re-solves of it
+    /// (and the editor's requests on it) may import without reading files again.
+    pub fn imported(&self) -> ImportRoot {
+        ImportRoot::Preloaded(Arc::new(self.imports.iter().map(|i| (i.step.clone(), i.model.clone())).collect()))
     }
 
     /// Parses scene text. `overrides` replace parameter values (by name) before anything

@@ -201,6 +201,8 @@ pub struct RawPatch {
     pub trim: Option<Spanned<RawTrim>>,
     /// Fills: the hole's edges, in loop order.
     pub edges: Option<Spanned<Vec<Spanned<RawEdge>>>>,
+    /// Fills: a hole of an imported model, `"MODEL.holeK"`, as the whole loop.
+    pub hole: Option<Spanned<String>>,
     /// Fills: the pole (default above the loop's centroid).
     pub pole: Option<Spanned<[NumOrExpr; 3]>>,
     /// Fills: factor on the default pole height.
@@ -271,6 +273,7 @@ optional_keys!(
     cells,
     primary,
     edges,
+    hole,
     pole,
     height,
     ring,
@@ -299,6 +302,11 @@ pub struct RawEdge {
     pub curve: Option<Spanned<[NumOrExpr; 2]>>,
     /// Or a trim curve `"PATCH.CURVE"` of an earlier patch.
     pub trim: Option<Spanned<String>>,
+    /// Or an edge of an imported model, `"MODEL.edgeID"`, whole, run as its face runs it.
+    pub edge: Option<Spanned<String>>,
+    /// The face of an imported edge the fill meets, `"MODEL.faceID"` (needed when the
+    /// edge bounds two faces).
+    pub face: Option<Spanned<String>>,
     /// The curve's parameter at the edge's start and end (curve and trim edges).
     pub t: Option<Spanned<[NumOrExpr; 2]>>,
     /// This edge's fullness (overrides the patch's).
@@ -378,6 +386,17 @@ pub struct RawScene {
     /// Parameter studies drawn as image strips in the gallery.
     #[serde(default)]
     pub studies: Vec<Spanned<RawStudy>>,
+    /// CAD models whose faces, edges and holes the scene uses.
+    #[serde(default)]
+    pub import: IndexMap<String, Spanned<RawImport>>,
+}
+
+/// `[import.NAME]`: a CAD model.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawImport {
+    /// A STEP file, relative to the scene file's folder.
+    pub step: Spanned<String>,
 }
 
 /// `[[studies]]`: one picture per value of a parameter, with other parameters fixed.

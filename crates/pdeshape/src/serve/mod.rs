@@ -37,7 +37,7 @@ use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_io::model;
 use pdeshape_io::scene::edit;
-use pdeshape_io::scene::{LoadOptions, Scene};
+use pdeshape_io::scene::{ImportRoot, LoadOptions, Scene};
 use serde::Deserialize;
 use serde_json::{Value, json};
 use std::collections::HashMap;
@@ -109,6 +109,9 @@ impl Lane {
 
 struct AppState {
     initial: Option<(String, String)>,
+    /// The models the starting scene imported: the only files requests may import (their
+    /// text comes from a web page).
+    imports: ImportRoot,
     /// Live requests (`/api/model`): one solve per core at a time, each parallel inside.
     solves: Lane,
     /// Downloads (`/api/export`): one at a time, on one thread.
@@ -247,20 +250,21 @@ fn curves_answer(scene: &Scene, c: &CurvesRequest) -> Vec<wire::PatchCurves> {
 
 /// Runs the server until interrupted; prints the URL.
 pub fn run(o: ServeOptions) -> Result<()> {
-    let initial = match &o.scene {
+    let (initial, imports) = match &o.scene {
         Some(p) => {
             let text = pdeshape_io::scene::read_scene_file(p, &o.limits)?;
             let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-            // refuse a broken scene at start, with the scene error
-            Scene::parse_with(
-                &text,
-                &p.display().to_string(),
-                &name,
-                &LoadOptions { limits: o.limits, ..Default::default() },
-            )?;
-            Some((name, text))
+            // refuse a broken scene at start, with the scene error; its imports are read
+            // once, here, and are all that requests may import
+            let opts = LoadOptions {
+                limits: o.limits,
+                imports: ImportRoot::Dir(pdeshape_io::scene::scene_folder(p)),
+                ..Default::default()
+            };
+            let scene = Scene::parse_with(&text, &p.display().to_string(), &name, &opts)?;
+            (Some((name, text)), scene.imported())
         }
-        None => None,
+        None => (None, ImportRoot::Refused),
     };
     let rt = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     rt.block_on(async move {
@@ -272,7 +276,7 @@ pub fn run(o: ServeOptions) -> Result<()> {
         use std::io::Write as _;
         std::io::stdout().flush().ok();
         let listener = idle::IdleListener::new(listener, o.time_limit.saturating_add(IDLE_GRACE));
-        axum::serve(listener, router(initial, addr, o.limits, o.time_limit)).await.context("server stopped")
+        axum::serve(listener, router(initial, imports, addr, o.limits, o.time_limit)).await.context("server stopped")
     })
 }
 
@@ -292,6 +296,7 @@ fn allowed_hosts(addr: std::net::SocketAddr) -> Vec<String> {
 /// The application's routes for a server bound to `addr`.
 pub fn router(
     initial: Option<(String, String)>,
+    imports: ImportRoot,
     addr: std::net::SocketAddr,
     limits: Limits,
     time_limit: Duration,
@@ -301,6 +306,7 @@ pub fn router(
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
     let state = Arc::new(AppState {
         initial,
+        imports,
         solves: Lane::new(threads, MAX_QUEUED, threads, "solve"),
         exports: Lane::new(1, MAX_QUEUED_EXPORTS, 1, "export"),
         hosts: allowed_hosts(addr),
@@ -477,10 +483,11 @@ pub fn safe_name(name: Option<&str>) -> String {
 
 /// Applies the edits, resolves the scene and meshes every patch (at `time` for dynamic
 /// blends); errors are the scene's errors, ready to show.
-pub fn solve(req: &ModelRequest, limits: &Limits) -> Result<(Scene, String, Vec<Mesh>), String> {
+pub fn solve(req: &ModelRequest, limits: &Limits, imports: &ImportRoot) -> Result<(Scene, String, Vec<Mesh>), String> {
     let text = edit::apply(&req.text, &req.edits)?;
     let name = safe_name(req.name.as_deref());
-    let opts = LoadOptions { params: req.params.clone(), limits: *limits, ..Default::default() };
+    let opts =
+        LoadOptions { params: req.params.clone(), limits: *limits, imports: imports.clone(), ..Default::default() };
     let scene = Scene::parse_with(&text, &format!("{name}.toml"), &name, &opts).map_err(|e| e.to_string())?;
     let estimate: usize = scene.patches.iter().map(|p| p.vertices()).sum();
     if estimate > MAX_VERTICES {
@@ -495,13 +502,14 @@ pub fn solve(req: &ModelRequest, limits: &Limits) -> Result<(Scene, String, Vec<
 async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelRequest>) -> Response {
     let arrived = Instant::now();
     let limits = s.limits;
+    let imports = s.imports.clone();
     // diagnostics and encoding run inside the limits too
     let r = limited(&s, &s.solves, arrived, move || {
         let t0 = Instant::now();
         if let Some(c) = &req.curves {
             c.check()?;
         }
-        let (scene, text, meshes) = solve(&req, &limits)?;
+        let (scene, text, meshes) = solve(&req, &limits, &imports)?;
         // the answer's buffers are f32: a value that does not fit is an error, not an inf
         for m in &meshes {
             m.check_fits_f32("the editor's buffers")?;
@@ -547,8 +555,9 @@ async fn export_route(
     }
     let extension = format.map_or("step", |f| f.extension());
     let limits = s.limits;
+    let imports = s.imports.clone();
     let r = limited(&s, &s.exports, arrived, move || {
-        let (scene, _, meshes) = solve(&req, &limits)?;
+        let (scene, _, meshes) = solve(&req, &limits, &imports)?;
         let bytes = match format {
             Some(format) => {
                 let refs: Vec<&Mesh> = meshes.iter().collect();

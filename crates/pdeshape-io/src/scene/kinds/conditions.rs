@@ -155,5 +155,6 @@ pub(super) fn finish(input: &PatchInput, c: Conditioned, surface: Arc<dyn Surfac
         solid: None,
         trim,
         fill: None,
+        hole: None,
     })
 }

@@ -121,5 +121,6 @@ pub(in crate::scene) fn build_solid(ctx: &Ctx, pname: &str, key: &str, p: &Spann
         solid: Some(crate::scene::SolidSetup { blend, faces, cells, primary }),
         trim: None,
         fill: None,
+        hole: None,
     })
 }
