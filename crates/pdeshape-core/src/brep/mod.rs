@@ -9,6 +9,7 @@
 
 mod fill;
 mod holes;
+mod tessellate;
 
 use crate::Vec3;
 use crate::data::analytic::{AnalyticCurve, AnalyticSurface};
@@ -18,6 +19,7 @@ use std::sync::Arc;
 
 pub use fill::{EdgePieces, HoleFill, HoleFillError, edge_pieces, fill_hole, fill_uses, pieces_per_edge};
 pub use holes::{Corner, Hole, HoleKind, HoleUse, holes};
+pub use tessellate::{PER_EDGE, TessellateError, face_mesh};
 
 /// A face's surface.
 #[derive(Clone, Debug)]

@@ -371,7 +371,28 @@ pub fn context_meshes_with(scene: &Scene, t: f64, kinds: &[CurvatureKind]) -> Re
         m.check_finite()?;
         out.push(m);
     }
+    out.extend(import_meshes(scene));
     Ok(out)
+}
+
+/// The faces of the scene's imported models, meshed for drawing in context (edges about
+/// 1/60 of each model's size; faces that cannot be meshed — geometry not read, loops that
+/// do not close in the face's parameters — are left out).
+pub fn import_meshes(scene: &Scene) -> Vec<Mesh> {
+    let mut out = Vec::new();
+    for imp in &scene.imports {
+        let b = &imp.model.model.brep;
+        let target = b.size() / 60.0;
+        for (k, f) in b.faces.iter().enumerate() {
+            if let Ok(mut m) = pdeshape_core::brep::face_mesh(b, k, target)
+                && m.check_finite().is_ok()
+            {
+                m.name = format!("{}.face{}", imp.name, f.id);
+                out.push(m);
+            }
+        }
+    }
+    out
 }
 
 /// Renders patches (coloured) with the context surfaces (neutral), in the view of `r`:

@@ -5,7 +5,8 @@
 //!
 //! - `NAME.faceID`: the face `#ID` as a primary surface `S(s, v)` in the face surface's own
 //!   parameters (`s` = its `u`), usable wherever scenes take a surface (trimlines of blends,
-//!   curves on a surface, fill edges); not drawn in context;
+//!   curves on a surface, fill edges); drawn in context as the face, trimmed by its loops
+//!   (`model::import_meshes`);
 //! - `NAME.edgeID`: the edge `#ID` (an `EDGE_CURVE`), as a fill edge on its face;
 //! - `NAME.holeK`: the `K`-th loop of the free boundary, numbered as `holes` numbers them, as
 //!   a fill's whole loop.
@@ -141,8 +142,8 @@ pub(in crate::scene) fn import_surfaces(imports: &[SceneImport]) -> Vec<SceneSur
 
 /// The `v` domain of a face's surface: a B-spline's knot range; the analytic surfaces'
 /// angle `[0, 2π)` where `v` is an angle (sphere's latitude `[−π/2, π/2]`), else unbounded
-/// directions as `[−1, 1]` (a face is not drawn in context, so the domain only names the
-/// surface's own range).
+/// directions as `[−1, 1]` (faces are drawn from their loops, not from this domain, so it
+/// only names the surface's own range).
 fn face_v_domain(s: &FaceSurface) -> VDomain {
     use pdeshape_core::data::analytic::AnalyticKind;
     match s {
