@@ -292,6 +292,12 @@ pub fn fit_filled(
 
 /// Writes `m` with the filled holes sewn in to `out` (atomically).
 pub fn write_filled(m: &StepModel, holes: &[Hole], filled: &[FilledHole], out: &Path) -> Result<(), String> {
+    let bytes = filled_bytes(m, holes, filled)?;
+    write_atomic(out, |w| w.write_all(&bytes)).map_err(|e| format!("{}: {e}", out.display()))
+}
+
+/// The bytes of `m` with the filled holes sewn in (what [`write_filled`] writes).
+pub fn filled_bytes(m: &StepModel, holes: &[Hole], filled: &[FilledHole]) -> Result<Vec<u8>, String> {
     let size = m.brep.size();
     // a shell is closed when all its holes are filled
     let shell_of = |h: &Hole| m.brep.faces[h.uses[0].face].shell;
@@ -311,8 +317,7 @@ pub fn write_filled(m: &StepModel, holes: &[Hole], filled: &[FilledHole], out: &
     // file's edges' offset from their faces
     let edge_offset = filled.iter().fold(0.0, |a, f| max_nan(a, f.edge_offset));
     let tol = 10.0 * (1e-7 * size + edge_offset);
-    let bytes = sewn_step(m, &faces, tol)?;
-    write_atomic(out, |w| w.write_all(&bytes)).map_err(|e| format!("{}: {e}", out.display()))
+    sewn_step(m, &faces, tol)
 }
 
 /// The fills of a scene that imports a model, fitted for [`write_filled`]: every patch must

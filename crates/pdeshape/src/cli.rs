@@ -204,7 +204,8 @@ enum Command {
     },
     /// Serve the interactive editor (a local web page) on 127.0.0.1.
     Serve {
-        /// Scene to open (default: a chooser of the built-in examples).
+        /// Scene to open (default: a chooser of the built-in examples), or a STEP model
+        /// (.step, .stp): its faces drawn, a click on a hole's loop fills it.
         scene: Option<PathBuf>,
         /// Port (0 picks a free one).
         #[arg(long, default_value_t = 8080)]

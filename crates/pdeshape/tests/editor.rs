@@ -13,7 +13,7 @@ use serde_json::{Value, json};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::{Kill, serve};
+use common::{Kill, serve, serve_file};
 use std::process::{Command, Stdio};
 
 fn free_port() -> u16 {
@@ -169,6 +169,59 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
     )
     .await;
     assert!(d.as_u64().unwrap() > 10_000, "{d}");
+    c.close().await.unwrap();
+}
+
+/// `pdeshape serve MODEL.step`: the model's faces drawn from their loops, its holes as
+/// orange loops; a click on a hole's loop adds a fill of it (order 6) to the scene, solved
+/// and drawn; a drag that starts on a loop orbits and adds nothing.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_editor_opens_a_step_model_and_fills_a_clicked_hole_in_chromium() {
+    let Some((c, _driver)) = browser().await else { return };
+    let model = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/step/rounded-box-corners.step");
+    let (_server, url) = serve_file(Some(&model));
+    c.goto(&url).await.unwrap();
+    wait_for(&c, "the model", "return window.pdeshape.frames > 0 && window.pdeshape.contextFaces").await;
+    let faces = js(&c, "return window.pdeshape.contextFaces").await;
+    assert_eq!(faces.as_array().unwrap().len(), 18, "{faces}");
+    assert!(faces.as_array().unwrap().contains(&json!("rounded_box_corners.face137")), "{faces}");
+    let holes = js(&c, "return window.pdeshape.holes").await;
+    assert_eq!(holes.as_array().unwrap().len(), 8, "{holes}");
+    assert_eq!(js(&c, "return window.pdeshape.vertexCount").await, json!(0));
+    let h0 = js(&c, "return window.pdeshape.meshHash").await.as_str().unwrap().to_string();
+    let shot0 = c.screenshot().await.unwrap();
+
+    // a drag from a loop orbits the view; nothing is filled
+    let at = js(&c, "return window.pdeshape.holeScreenPos('rounded_box_corners.hole1')").await;
+    drag(&c, pos(&at), (40.0, 0.0), 3).await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    assert_eq!(js(&c, "return window.pdeshape.lastFill || null").await, Value::Null);
+
+    // a click on hole 1's loop
+    let at = js(&c, "return window.pdeshape.holeScreenPos('rounded_box_corners.hole1')").await;
+    drag(&c, pos(&at), (0.0, 0.0), 0).await;
+    let h1 = wait_changed(&c, "the fill", &h0).await;
+    assert_ne!(h1, h0);
+    let text = js(&c, "return window.pdeshape.header.text").await;
+    let text = text.as_str().unwrap();
+    assert!(
+        text.contains("[patches.fill_rounded_box_corners_hole1]")
+            && text.contains("hole = \"rounded_box_corners.hole1\""),
+        "{text}"
+    );
+    assert!(js(&c, "return window.pdeshape.vertexCount").await.as_u64().unwrap() > 1000);
+    let shot1 = c.screenshot().await.unwrap();
+    assert_ne!(shot0, shot1, "the picture did not change after the fill");
+
+    // the STEP download is the model with the fill sewn in (the input is 49 929 bytes)
+    c.find(Locator::Css("button[data-format=step]")).await.unwrap().click().await.unwrap();
+    let d = wait_for(
+        &c,
+        "the STEP download",
+        "const d = window.pdeshape.lastDownload; return d && d.name.endsWith('.step') && d.bytes",
+    )
+    .await;
+    assert!(d.as_u64().unwrap() > 49_929, "{d}");
     c.close().await.unwrap();
 }
 

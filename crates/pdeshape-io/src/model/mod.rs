@@ -381,14 +381,30 @@ pub fn context_meshes_with(scene: &Scene, t: f64, kinds: &[CurvatureKind]) -> Re
 pub fn import_meshes(scene: &Scene) -> Vec<Mesh> {
     let mut out = Vec::new();
     for imp in &scene.imports {
+        for m in imp.model.face_meshes() {
+            let mut m = m.clone();
+            m.name = format!("{}.{}", imp.name, m.name);
+            out.push(m);
+        }
+    }
+    out
+}
+
+/// The holes of the scene's imported models as polylines (33 points an edge), named
+/// `MODEL.holeK` as scenes name them.
+pub fn import_hole_loops(scene: &Scene) -> Vec<(String, Vec<pdeshape_core::Vec3>)> {
+    let mut out = Vec::new();
+    for imp in &scene.imports {
         let b = &imp.model.model.brep;
-        let target = b.size() / 60.0;
-        for (k, f) in b.faces.iter().enumerate() {
-            if let Ok(mut m) = pdeshape_core::brep::face_mesh(b, k, target)
-                && m.check_finite().is_ok()
-            {
-                m.name = format!("{}.face{}", imp.name, f.id);
-                out.push(m);
+        for (k, h) in imp.model.holes.iter().enumerate() {
+            let mut points = Vec::new();
+            for u in &h.uses {
+                let e = &b.edges[u.edge];
+                let (t0, t1) = if u.forward { e.range } else { (e.range.1, e.range.0) };
+                points.extend((0..=32).map(|i| e.point(t0 + (t1 - t0) * i as f64 / 32.0)));
+            }
+            if points.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                out.push((format!("{}.hole{}", imp.name, k + 1), points));
             }
         }
     }

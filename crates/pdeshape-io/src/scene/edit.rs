@@ -72,6 +72,10 @@ pub fn apply(text: &str, edits: &[Edit]) -> Result<String, String> {
     let mut doc: DocumentMut = text.parse().map_err(|e| format!("scene text: {e}"))?;
     for e in edits {
         let where_ = path_text(&e.path);
+        if e.op.as_deref() == Some("fill") {
+            fill_hole(&mut doc, &e.path, &e.value).map_err(|m| format!("edit {where_}: {m}"))?;
+            continue;
+        }
         let (last, parents) = e.path.split_last().ok_or("an edit needs a path")?;
         let mut item: &mut Item = doc.as_item_mut();
         for seg in parents {
@@ -117,6 +121,39 @@ pub fn apply(text: &str, edits: &[Edit]) -> Result<String, String> {
         }
     }
     Ok(doc.to_string())
+}
+
+/// The `fill` edit (the editor's click on a hole): `[patches.NAME]` of `kind = "fill"`,
+/// `hole = VALUE`, `order = 6` added, at the path `["patches", NAME]`.
+fn fill_hole(doc: &mut DocumentMut, path: &[Seg], value: &Value) -> Result<(), String> {
+    let [Seg::Key(patches), Seg::Key(name)] = path else {
+        return Err("a fill is added at [\"patches\", NAME]".into());
+    };
+    let Value::String(hole) = value else {
+        return Err("a fill's value is the hole's name (\"MODEL.holeK\")".into());
+    };
+    if patches != "patches" {
+        return Err("a fill is added at [\"patches\", NAME]".into());
+    }
+    let table = doc
+        .as_table_mut()
+        .entry("patches")
+        .or_insert_with(|| {
+            let mut t = toml_edit::Table::new();
+            t.set_implicit(true);
+            Item::Table(t)
+        })
+        .as_table_mut()
+        .ok_or("`patches` is not a table")?;
+    if table.contains_key(name) {
+        return Err(format!("the patch `{name}` exists"));
+    }
+    let mut t = toml_edit::Table::new();
+    t.insert("kind", toml_edit::value("fill"));
+    t.insert("hole", toml_edit::value(hole.as_str()));
+    t.insert("order", toml_edit::value(6));
+    table.insert(name, Item::Table(t));
+    Ok(())
 }
 
 /// The scene text with parameter values replaced (`a = 1.37` for `--set a=1.37`): the text
@@ -218,6 +255,26 @@ mod tests {
         assert!(e.contains("no such entry `d`"), "{e}");
         let e = apply(text, &[edit("delete", json!(["curves", "c", "bspline", 7]), Value::Null)]).unwrap_err();
         assert!(e.contains("index 7 of an array of 3"), "{e}");
+    }
+
+    /// The editor's click on a hole: a fill patch added, in a scene with patches or without
+    /// (its `[patches]` table made); a name taken, a bad path or value refused.
+    #[test]
+    fn a_fill_edit_adds_a_fill_of_the_hole() {
+        let text = "# the model\n[import.box]\nstep = \"box.step\"\n";
+        let out = apply(text, &[edit("fill", json!(["patches", "f1"]), json!("box.hole1"))]).unwrap();
+        assert_eq!(out, format!("{text}\n[patches.f1]\nkind = \"fill\"\nhole = \"box.hole1\"\norder = 6\n"));
+        let out2 = apply(&out, &[edit("fill", json!(["patches", "f2"]), json!("box.hole2"))]).unwrap();
+        assert!(
+            out2.starts_with(&out) && out2.contains("[patches.f2]\nkind = \"fill\"\nhole = \"box.hole2\""),
+            "{out2}"
+        );
+        let e = apply(&out, &[edit("fill", json!(["patches", "f1"]), json!("box.hole3"))]).unwrap_err();
+        assert!(e.contains("the patch `f1` exists"), "{e}");
+        let e = apply(text, &[edit("fill", json!(["curves", "f1"]), json!("box.hole3"))]).unwrap_err();
+        assert!(e.contains("[\"patches\", NAME]"), "{e}");
+        let e = apply(text, &[edit("fill", json!(["patches", "f1"]), json!(3))]).unwrap_err();
+        assert!(e.contains("the hole's name"), "{e}");
     }
 
     /// A parameter set in the text resolves as the same override does, bit for bit, in

@@ -35,6 +35,9 @@ pub struct ImportedModel {
     pub model: StepModel,
     /// Its free boundary's loops, numbered from 1 in names.
     pub holes: Vec<Hole>,
+    /// Its faces meshed for drawing, made once on first use (the editor redraws them with
+    /// every answer).
+    meshes: std::sync::OnceLock<Vec<pdeshape_core::mesh::Mesh>>,
 }
 
 impl std::fmt::Debug for ImportedModel {
@@ -52,7 +55,25 @@ impl ImportedModel {
     pub fn read(path: &Path, limits: &pdeshape_core::limits::Limits) -> Result<ImportedModel, String> {
         let model = read_step(path, limits).map_err(|e| e.to_string())?;
         let holes = holes(&model.brep);
-        Ok(ImportedModel { path: path.to_path_buf(), model, holes })
+        Ok(ImportedModel { path: path.to_path_buf(), model, holes, meshes: Default::default() })
+    }
+
+    /// Its faces meshed for drawing (`faceID`; edges about 1/60 of the model's size):
+    /// faces that cannot be meshed — geometry not read, loops that do not close in the
+    /// face's parameters — are left out.
+    pub fn face_meshes(&self) -> &[pdeshape_core::mesh::Mesh] {
+        self.meshes.get_or_init(|| {
+            let b = &self.model.brep;
+            let target = b.size() / 60.0;
+            (0..b.faces.len())
+                .filter_map(|k| {
+                    let mut m = pdeshape_core::brep::face_mesh(b, k, target).ok()?;
+                    m.check_finite().ok()?;
+                    m.name = format!("face{}", b.faces[k].id);
+                    Some(m)
+                })
+                .collect()
+        })
     }
 }
 

@@ -55,6 +55,27 @@ function upload(header, bytes) {
   });
   return patches;
 }
+// the imported models' faces (drawn in a neutral colour around the patches) and holes
+// (orange loops; a click on one adds a fill of it to the scene)
+function uploadContext(header, bytes) {
+  const f32 = (r) => wire.f32(bytes, r), u32 = (r) => wire.u32(bytes, r);
+  const buf = (data, loc, size) => {
+    const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b); gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, size, gl.FLOAT, false, 0, 0);
+  };
+  const faces = (header.context || []).map((m) => {
+    const vao = gl.createVertexArray(); gl.bindVertexArray(vao);
+    buf(f32(m.positions), 0, 3); buf(f32(m.normals), 1, 3); buf(new Float32Array(m.vertices), 2, 1);
+    const ib = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, u32(m.indices), gl.STATIC_DRAW);
+    gl.bindVertexArray(null);
+    return { vao, n: m.indices.count, meta: m, pos: f32(m.positions).slice() };
+  });
+  const holes = (header.holes || []).map((h) => {
+    const vao = gl.createVertexArray(); gl.bindVertexArray(vao); buf(f32(h.points), 0, 3); gl.bindVertexArray(null);
+    return { vao, n: h.points.count / 3, name: h.name, pos: f32(h.points).slice() };
+  });
+  return { faces, holes };
+}
 function bounds(patches) {
   let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   for (const p of patches) for (let i = 0; i < p.pos.length; i += 3)
@@ -86,6 +107,11 @@ function draw() {
   const ang = parseFloat($("stripeangle").value) * Math.PI / 180;
   gl.uniform1f(gl.getUniformLocation(surf, "stripes"), parseFloat($("stripes").value));
   gl.uniform2f(gl.getUniformLocation(surf, "axis"), Math.cos(ang), Math.sin(ang));
+  for (const f of model.context.faces) {
+    gl.uniform3fv(gl.getUniformLocation(surf, "color"), [0.74, 0.74, 0.72]);
+    gl.uniform1i(gl.getUniformLocation(surf, "mode"), field === "zebra" ? 3 : field === "isophotes" ? 4 : 0);
+    gl.bindVertexArray(f.vao); gl.drawElements(gl.TRIANGLES, f.n, gl.UNSIGNED_INT, 0);
+  }
   model.patches.forEach((p, i) => {
     const c = p.meta.color || PALETTE[i % PALETTE.length];
     gl.uniform3fv(gl.getUniformLocation(surf, "color"), c);
@@ -109,6 +135,8 @@ function draw() {
   }
   gl.uniform4f(gl.getUniformLocation(flat, "color"), 0.8, 0.1, 0.1, 1);
   for (const p of model.patches) for (const c of p.curves) { gl.bindVertexArray(c.vao); gl.drawArrays(gl.LINE_STRIP, 0, c.n); }
+  gl.uniform4f(gl.getUniformLocation(flat, "color"), 0.95, 0.55, 0.05, 1);
+  for (const h of model.context.holes) { gl.bindVertexArray(h.vao); gl.drawArrays(gl.LINE_STRIP, 0, h.n); }
   if ($("handles").checked && handleCount) {
     gl.disable(gl.DEPTH_TEST);
     gl.uniform1f(gl.getUniformLocation(flat, "size"), 9 * devicePixelRatio);
@@ -266,7 +294,7 @@ function drawSeams(view, proj) {
 }
 // moves the camera's target to `p` and closes in, over ~0.4 s
 function flyTo(p) {
-  const b = bounds(model.patches);
+  const b = bounds(model.patches.concat(model.context.faces));
   const dist = 0.45 * Math.hypot(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]);
   const from = { target: cam.target.slice(), dist: cam.dist }, t0 = performance.now();
   S.flying = true;
@@ -289,7 +317,7 @@ S.flyTo = flyTo;
 function curvesRequest() {
   const on = $("section").checked || $("combs").checked || $("isocomb").checked;
   if (!on || !model) return undefined;
-  const b = bounds(model.patches), k = "xyz".indexOf($("secaxis").value);
+  const b = bounds(model.patches.concat(model.context.faces)), k = "xyz".indexOf($("secaxis").value);
   const offset = b.lo[k] + parseFloat($("secpos").value) * (b.hi[k] - b.lo[k]);
   $("secval").textContent = offset.toFixed(3);
   return {
@@ -303,7 +331,7 @@ function buildCurves() {
   const c = model && model.header.curves;
   S.curves = null;
   if (!c) { curveCount = 0; return; }
-  const b = bounds(model.patches);
+  const b = bounds(model.patches.concat(model.context.faces));
   const size = Math.hypot(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]);
   const norms = [];
   const kn = (k, i) => Math.hypot(k[i], k[i + 1], k[i + 2]);
@@ -388,7 +416,10 @@ async function solve(diagnostics) {
       const { header, data } = wire.decode(await r.arrayBuffer());
       const first = !model;
       if (edits === sent) { scene.text = header.text; edits = []; }
-      model = { header, patches: upload(header, data) };
+      if (model) for (const f of model.context.faces) gl.deleteVertexArray(f.vao);
+      model = { header, patches: upload(header, data), context: uploadContext(header, data) };
+      S.contextFaces = model.context.faces.map((f) => f.meta.name);
+      S.holes = model.context.holes.map((h) => h.name);
       S.header = header; S.data = data; S.dataHash = null;
       S.vertexCount = header.patches.reduce((a, p) => a + p.vertices, 0);
       // the diagnostics (and the seam markers from them) belong to the model they came with
@@ -423,7 +454,7 @@ function summary(d) {
 let diagTimer = null;
 function changed() { solve(false); clearTimeout(diagTimer); diagTimer = setTimeout(() => solve(true), 400); }
 function fit() {
-  const b = bounds(model.patches);
+  const b = bounds(model.patches.concat(model.context.faces));
   cam.target = scl(add(b.lo, b.hi), 0.5);
   const v = model.header.view;
   if (v) { cam.az = v.azimuth * Math.PI / 180; cam.el = v.elevation * Math.PI / 180; }
@@ -525,6 +556,7 @@ canvas.addEventListener("pointerdown", (e) => {
     const hd = model.header.editables.handles[h];
     drag = { kind: "handle", index: h, x: e.offsetX, y: e.offsetY, start: hd.position.slice(), path: hd.path };
   } else drag = { kind: e.shiftKey || e.button === 2 ? "pan" : "orbit", x: e.offsetX, y: e.offsetY };
+  drag.x0 = e.offsetX; drag.y0 = e.offsetY;
 });
 canvas.addEventListener("pointermove", (e) => {
   if (!drag) return;
@@ -551,7 +583,38 @@ canvas.addEventListener("pointermove", (e) => {
     uploadHandles(); redraw(); changed();
   }
 });
-canvas.addEventListener("pointerup", () => { drag = null; });
+// the hole whose loop passes within 10 px of (x, y), if any
+function pickHole(x, y) {
+  if (!model) return null;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  let best = null, bd = 10;
+  for (const hl of model.context.holes) {
+    for (let i = 0; i < hl.pos.length; i += 3) {
+      const [sx, sy, ww] = project([hl.pos[i], hl.pos[i + 1], hl.pos[i + 2]], w, h);
+      const d = Math.hypot(sx - x, sy - y);
+      if (ww > 0 && d < bd) { bd = d; best = hl.name; }
+    }
+  }
+  return best;
+}
+S.holeScreenPos = (name) => {
+  const hl = model.context.holes.find((x) => x.name === name), r = canvas.getBoundingClientRect();
+  const [x, y] = project([hl.pos[0], hl.pos[1], hl.pos[2]], canvas.clientWidth, canvas.clientHeight);
+  return [r.left + x, r.top + y];
+};
+// a click (no drag) on a hole's loop fills it: a `kind = "fill"` patch of order 6 is added
+// to the scene text (the server's `fill` edit), unless a patch already fills it
+canvas.addEventListener("pointerup", (e) => {
+  const click = drag && drag.kind !== "handle" && Math.hypot(e.offsetX - drag.x0, e.offsetY - drag.y0) < 3;
+  drag = null;
+  if (!click) return;
+  const hole = pickHole(e.offsetX, e.offsetY);
+  if (!hole) return;
+  const name = "fill_" + hole.replace(/[^A-Za-z0-9_]/g, "_");
+  if (edits.some((ed) => ed.op === "fill" && ed.value === hole) || (scene.text || "").includes(`"${hole}"`)) return;
+  edits.push({ op: "fill", path: ["patches", name], value: hole });
+  S.lastFill = hole; changed();
+});
 canvas.addEventListener("wheel", (e) => { e.preventDefault(); cam.dist *= Math.exp(e.deltaY * 0.001); redraw(); }, { passive: false });
 window.addEventListener("resize", redraw);
 

@@ -252,7 +252,7 @@ fn curves_answer(scene: &Scene, c: &CurvesRequest) -> Vec<wire::PatchCurves> {
 pub fn run(o: ServeOptions) -> Result<()> {
     let (initial, imports) = match &o.scene {
         Some(p) => {
-            let text = pdeshape_io::scene::read_scene_file(p, &o.limits)?;
+            let text = if is_model(p) { model_scene(p) } else { pdeshape_io::scene::read_scene_file(p, &o.limits)? };
             let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
             // refuse a broken scene at start, with the scene error; its imports are read
             // once, here, and are all that requests may import
@@ -291,6 +291,41 @@ fn allowed_hosts(addr: std::net::SocketAddr) -> Vec<String> {
         }
     }
     hosts
+}
+
+/// Whether `p` names a CAD model (`.step`, `.stp`) rather than a scene.
+fn is_model(p: &std::path::Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("step") || e.eq_ignore_ascii_case("stp"))
+}
+
+/// The scene the editor opens for a model file: the model imported under its file stem
+/// (letters, digits and `_`; `model` when that is not a name a scene may use).
+fn model_scene(p: &std::path::Path) -> String {
+    let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut name: String = stem.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+    if !name.starts_with(|c: char| c.is_ascii_alphabetic())
+        || pdeshape_io::scene::RESERVED.contains(&name.as_str())
+        || name.len() > 40
+    {
+        name = "model".into();
+    }
+    let file = p.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    // the file name as a TOML string (quotes, backslashes and control characters escaped)
+    let mut quoted = String::from("\"");
+    for c in file.chars() {
+        match c {
+            '"' | '\\' => {
+                quoted.push('\\');
+                quoted.push(c);
+            }
+            c if c.is_control() => quoted.push_str(&format!("\\u{:04X}", c as u32)),
+            c => quoted.push(c),
+        }
+    }
+    quoted.push('"');
+    format!("# the model's holes are drawn orange: click one to fill it\n[import.{name}]\nstep = {quoted}\n")
 }
 
 /// The application's routes for a server bound to `addr`.
@@ -466,6 +501,7 @@ struct Solved {
     scene: Scene,
     text: String,
     meshes: Vec<Mesh>,
+    context: Vec<Mesh>,
     solve_ms: f64,
 }
 
@@ -515,12 +551,14 @@ async fn model_route(State(s): State<Arc<AppState>>, Json(req): Json<ModelReques
             m.check_fits_f32("the editor's buffers")?;
         }
         let curves = req.curves.as_ref().map(|c| curves_answer(&scene, c));
-        let solved = Solved { scene, text, meshes, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
+        let context = model::import_meshes(&scene);
+        let solved = Solved { scene, text, meshes, context, solve_ms: t0.elapsed().as_secs_f64() * 1e3 };
         Ok(wire::encode(
             &wire::Model {
                 scene: &solved.scene,
                 text: &solved.text,
                 meshes: &solved.meshes,
+                context: &solved.context,
                 solve_ms: solved.solve_ms,
             },
             req.diagnostics,
@@ -565,6 +603,13 @@ async fn export_route(
             }
             // measured B-spline faces at the editor's time (inside the time limit: the
             // fit checks the cancel flag)
+            // a scene that imports a model: that model with the scene's fills of its
+            // holes sewn in, as `build -o OUT.step` writes it
+            None if !scene.imports.is_empty() => {
+                let relative = pdeshape_io::holes::FillHolesOptions::default().relative;
+                let (m, filled) = pdeshape_io::holes::scene_fills(&scene, relative)?;
+                pdeshape_io::holes::filled_bytes(&m.model, &m.holes, &filled)?
+            }
             None => {
                 let faces = pdeshape_io::cad::fit_scene(
                     &scene,

@@ -19,6 +19,8 @@ pub struct Model<'a> {
     pub text: &'a str,
     /// One mesh per patch.
     pub meshes: &'a [Mesh],
+    /// The imported models' faces, drawn around the patches (`model::import_meshes`).
+    pub context: &'a [Mesh],
     /// Time spent solving and meshing (ms).
     pub solve_ms: f64,
 }
@@ -49,6 +51,11 @@ struct Header<'a> {
     time_range: Option<[f64; 2]>,
     view: View,
     patches: Vec<Patch<'a>>,
+    /// Meshes drawn around the patches: the faces of imported models, named
+    /// `MODEL.faceID`.
+    context: Vec<ContextMesh<'a>>,
+    /// The holes of imported models, named `MODEL.holeK`, each its loop of points.
+    holes: Vec<HoleLoop>,
     /// The text's draggable handles and editable trims (`scene::edit`).
     editables: Value,
     /// `model::mesh_hash` of the meshes (tests compare it).
@@ -58,6 +65,23 @@ struct Header<'a> {
     diagnostics: Option<SceneReport>,
     /// The curve tools' answer, when asked for.
     curves: Option<Vec<PatchCurves>>,
+}
+
+/// A mesh drawn in context.
+#[derive(Serialize)]
+struct ContextMesh<'a> {
+    name: &'a str,
+    vertices: usize,
+    positions: Slice,
+    normals: Slice,
+    indices: Slice,
+}
+
+/// A hole of an imported model: its name and its loop's points.
+#[derive(Serialize)]
+struct HoleLoop {
+    name: String,
+    points: Slice,
 }
 
 /// One patch's curves for the curve tools.
@@ -227,6 +251,21 @@ pub fn encode(s: &Model, diagnostics: bool, curves: Option<Vec<PatchCurves>>) ->
             trim: trim(p),
         });
     }
+    let context = s
+        .context
+        .iter()
+        .map(|m| ContextMesh {
+            name: &m.name,
+            vertices: m.positions.len(),
+            positions: buf.points(m.positions.iter()),
+            normals: buf.points(m.normals.iter()),
+            indices: buf.u32s(m.all_triangles().into_iter().flatten()),
+        })
+        .collect();
+    let holes = model::import_hole_loops(s.scene)
+        .into_iter()
+        .map(|(name, points)| HoleLoop { name, points: buf.points(points.iter()) })
+        .collect();
     let header = Header {
         name: &s.scene.name,
         title: s.scene.title.as_deref(),
@@ -248,6 +287,8 @@ pub fn encode(s: &Model, diagnostics: bool, curves: Option<Vec<PatchCurves>>) ->
         time_range: s.scene.patches.iter().find_map(|p| p.dynamic.as_ref()).map(|d| [d.times.0, d.times.1]),
         view: View { azimuth: s.scene.render.azimuth, elevation: s.scene.render.elevation },
         patches,
+        context,
+        holes,
         editables: edit::editables(s.text),
         hash: model::mesh_hash(s.meshes),
         solve_ms: s.solve_ms,

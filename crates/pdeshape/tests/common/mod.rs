@@ -25,7 +25,14 @@ pub fn example(name: &str) -> PathBuf {
 /// binary is the one under test, or `PDESHAPE_SERVE_BIN` when set (to measure the editor
 /// against a release build).
 pub fn serve(scene: Option<&str>) -> (Kill, String) {
-    let mut args: Vec<String> = scene.map(|s| example(s).to_string_lossy().into_owned()).into_iter().collect();
+    serve_file(scene.map(example).as_deref())
+}
+
+/// `pdeshape serve FILE --port 0` (a scene or a model file; none: the chooser); the child
+/// and the URL it printed.
+#[allow(dead_code)]
+pub fn serve_file(file: Option<&std::path::Path>) -> (Kill, String) {
+    let mut args: Vec<String> = file.map(|s| s.to_string_lossy().into_owned()).into_iter().collect();
     args.extend(["--port".into(), "0".into()]);
     let bin = std::env::var("PDESHAPE_SERVE_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_pdeshape").to_string());
     let mut child =
