@@ -191,6 +191,31 @@ async fn the_editor_opens_a_step_model_and_fills_a_clicked_hole_in_chromium() {
     let h0 = js(&c, "return window.pdeshape.meshHash").await.as_str().unwrap().to_string();
     let shot0 = c.screenshot().await.unwrap();
 
+    // names under the mouse: a hole's loop, a face (the middle of the view is on the box)
+    let at = js(&c, "return window.pdeshape.holeScreenPos('rounded_box_corners.hole1')").await;
+    let (x, y) = pos(&at);
+    c.perform_actions(MouseActions::new("mouse".into()).then(PointerAction::MoveTo { duration: None, x, y }))
+        .await
+        .unwrap();
+    let name = wait_for(&c, "the hole's name", "return window.pdeshape.hoverName").await;
+    assert_eq!(name, json!("rounded_box_corners.hole1"));
+    // a point inside each face in turn: where the face is in sight, it is named
+    let mut seen = Vec::new();
+    for f in faces.as_array().unwrap() {
+        let at = js(&c, &format!("return window.pdeshape.faceScreenPos({f})")).await;
+        let (x, y) = pos(&at);
+        c.perform_actions(MouseActions::new("mouse".into()).then(PointerAction::MoveTo { duration: None, x, y }))
+            .await
+            .unwrap();
+        tokio::time::sleep(Duration::from_millis(150)).await;
+        if js(&c, "return window.pdeshape.hoverName").await == *f {
+            seen.push(f.clone());
+        }
+    }
+    // three flat faces and three fillets face the camera; the test's point of three of them
+    // is in sight (measured; the others' points are behind an edge of the box)
+    assert!(seen.len() >= 3, "faces named under the mouse: {seen:?}");
+
     // a drag from a loop orbits the view; nothing is filled
     let at = js(&c, "return window.pdeshape.holeScreenPos('rounded_box_corners.hole1')").await;
     drag(&c, pos(&at), (40.0, 0.0), 3).await;

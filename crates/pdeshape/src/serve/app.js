@@ -68,7 +68,7 @@ function uploadContext(header, bytes) {
     buf(f32(m.positions), 0, 3); buf(f32(m.normals), 1, 3); buf(new Float32Array(m.vertices), 2, 1);
     const ib = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, u32(m.indices), gl.STATIC_DRAW);
     gl.bindVertexArray(null);
-    return { vao, n: m.indices.count, meta: m, pos: f32(m.positions).slice() };
+    return { vao, n: m.indices.count, meta: m, pos: f32(m.positions).slice(), idx: u32(m.indices).slice() };
   });
   const holes = (header.holes || []).map((h) => {
     const vao = gl.createVertexArray(); gl.bindVertexArray(vao); buf(f32(h.points), 0, 3); gl.bindVertexArray(null);
@@ -597,6 +597,60 @@ function pickHole(x, y) {
   }
   return best;
 }
+// the imported face under (x, y): the nearest of the triangles whose screen image holds it
+function pickFace(x, y) {
+  if (!model) return null;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  const { view, proj } = matrices(w, h), m = mul4(proj, view);
+  let best = null, bz = Infinity;
+  for (const f of model.context.faces) {
+    const p = f.pos, n = p.length / 3, sx = new Float32Array(n), sy = new Float32Array(n), sw = new Float32Array(n);
+    for (let i = 0; i < n; i++) {
+      const a = p[3 * i], b = p[3 * i + 1], c = p[3 * i + 2];
+      const ww = m[3] * a + m[7] * b + m[11] * c + m[15];
+      sx[i] = ((m[0] * a + m[4] * b + m[8] * c + m[12]) / ww * 0.5 + 0.5) * w;
+      sy[i] = (1 - ((m[1] * a + m[5] * b + m[9] * c + m[13]) / ww * 0.5 + 0.5)) * h;
+      sw[i] = ww;
+    }
+    for (let t = 0; t < f.idx.length; t += 3) {
+      const i = f.idx[t], j = f.idx[t + 1], k = f.idx[t + 2];
+      if (sw[i] <= 0 || sw[j] <= 0 || sw[k] <= 0) continue;
+      const d = (sx[j] - sx[i]) * (sy[k] - sy[i]) - (sx[k] - sx[i]) * (sy[j] - sy[i]);
+      if (d === 0) continue;
+      const u = ((x - sx[i]) * (sy[k] - sy[i]) - (sx[k] - sx[i]) * (y - sy[i])) / d;
+      const v = ((sx[j] - sx[i]) * (y - sy[i]) - (x - sx[i]) * (sy[j] - sy[i])) / d;
+      if (u < 0 || v < 0 || u + v > 1) continue;
+      const z = sw[i] + u * (sw[j] - sw[i]) + v * (sw[k] - sw[i]);
+      if (z < bz) { bz = z; best = f.meta.name; }
+    }
+  }
+  return best;
+}
+// the name under the mouse (a hole's loop before the face behind it), shown beside it
+const tip = document.createElement("div");
+tip.id = "hovername";
+tip.style.cssText = "position:absolute;pointer-events:none;background:#223;color:#fff;font:12px sans-serif;padding:2px 6px;border-radius:3px;display:none";
+canvas.parentElement.appendChild(tip);
+let hoverQueued = null;
+canvas.addEventListener("pointermove", (e) => {
+  if (drag || !model || !model.context.faces.length && !model.context.holes.length) return;
+  const first = !hoverQueued;
+  hoverQueued = [e.offsetX, e.offsetY];
+  if (!first) return;
+  requestAnimationFrame(() => {
+    const [x, y] = hoverQueued; hoverQueued = null;
+    const name = pickHole(x, y) || pickFace(x, y);
+    S.hoverName = name;
+    tip.textContent = name || ""; tip.style.display = name ? "block" : "none";
+    tip.style.left = `${x + 14}px`; tip.style.top = `${y + 10}px`;
+  });
+});
+S.faceScreenPos = (name) => {
+  const f = model.context.faces.find((x) => x.meta.name === name), r = canvas.getBoundingClientRect();
+  const t = 3 * Math.floor(f.idx.length / 6), c = [0, 1, 2].map((k) => (f.pos[3 * f.idx[t] + k] + f.pos[3 * f.idx[t + 1] + k] + f.pos[3 * f.idx[t + 2] + k]) / 3);
+  const [x, y] = project(c, canvas.clientWidth, canvas.clientHeight);
+  return [r.left + x, r.top + y];
+};
 S.holeScreenPos = (name) => {
   const hl = model.context.holes.find((x) => x.name === name), r = canvas.getBoundingClientRect();
   const [x, y] = project([hl.pos[0], hl.pos[1], hl.pos[2]], canvas.clientWidth, canvas.clientHeight);
