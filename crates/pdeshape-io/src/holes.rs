@@ -1,6 +1,6 @@
 //! The holes of an imported model: listed (a typed report for `holes` and its JSON), and
 //! filled — each hole by a fill of order 4 (G1) or 6 (G2) from the faces around
-//! (`pdeshape_core::brep::fill_hole`), fitted by a B-spline face of degree 3 or 5 that
+//! (`pdeshape_core::brep::fill_hole`), fitted by a B-spline face of degree 5 that
 //! interpolates the fill's cross derivatives at the loop, measured against the exact
 //! faces around after the fit, and sewn into the model (`export::sewn_step`).
 
@@ -261,7 +261,8 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
 }
 
 /// Fits the fill `fill` (of order `order`) of hole `index` (from 1) of `m` by a B-spline
-/// face of degree 3 (order 4) or 5 (order 6) to `relative` of the model's size, and
+/// face of degree 5 (interpolating the fill's first and second cross derivatives along the
+/// loop) to `relative` of the model's size, and
 /// measures the seam of the face against the faces around.
 pub fn fit_filled(
     m: &StepModel,
@@ -275,7 +276,10 @@ pub fn fit_filled(
     let fail = |e: String| format!("hole {index}: {e}");
     let h = holes.get(index.wrapping_sub(1)).ok_or_else(|| fail("no such hole".into()))?;
     let size = m.brep.size();
-    let degree = if order == 6 { 5 } else { 3 };
+    // degree 5 at both orders: against degree 3 at order 4 it needs fewer control points
+    // (cylinder 9 × 31 against 19 × 79), leaves the seam's angle 4–25× smaller and takes
+    // as long or half as long (BENCHMARKS.md, fill-holes)
+    let degree = 5;
     let fo = FitOptions {
         tolerance: Some(relative * size),
         degree,

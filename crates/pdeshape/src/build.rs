@@ -197,11 +197,11 @@ pub fn build_into_dir(scene: &Scene, dir: &Path) -> Result<Vec<PathBuf>> {
 
 /// `build -o OUT.step` of a scene that imports a model: the model written back exactly with
 /// the scene's fills of its holes sewn in, fitted as `fill-holes` fits them (the fill's
-/// order sets the degree: 3 for order 4, 5 for order 6).
+/// faces are of degree 5).
 fn imported_step(sc: &Scene, out: &Path, step: &StepOptions, quiet: bool) -> Result<()> {
     if step.degree.is_some() {
         return Err(crate::usage::usage(
-            "--degree does not apply to a scene that imports a model: each fill's order sets its face's degree (3 for order 4, 5 for order 6)",
+            "--degree does not apply to a scene that imports a model: its fills' faces are of degree 5, as fill-holes writes them",
         ));
     }
     let defaults = pdeshape_io::holes::FillHolesOptions::default();

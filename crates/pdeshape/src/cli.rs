@@ -123,7 +123,7 @@ enum Command {
         /// The output (.step or .stp for a STEP model; .obj, .ply or .stl for a mesh).
         #[arg(short, long)]
         out: PathBuf,
-        /// 4: G1 to the faces around (faces of degree 3); 6: G2 (degree 5).
+        /// 4: G1 to the faces around; 6: G2 (the new faces are of degree 5 at both).
         #[arg(long, default_value_t = 4, value_parser = fill_order)]
         order: usize,
         /// The holes to fill, by their numbers in `holes` (default: every hole).
