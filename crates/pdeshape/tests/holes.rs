@@ -178,6 +178,18 @@ fn bad_models_are_refused_with_the_entity_and_line() {
         "#43 = EDGE_CURVE('',#44,#1000,#46,.T.);\n#1000 = VERTEX_POINT('',#45);",
     );
     refused(&["holes", &s(&zero)], 1, &["#43 EDGE_CURVE", "zero length"]);
+    // a non-manifold edge: the bottom rim bounds a third face (a second disc)
+    let three = edited(
+        d,
+        "three.step",
+        "#16 = OPEN_SHELL('',(#17,#93));",
+        "#16 = OPEN_SHELL('',(#17,#93,#2000));\n#2000 = ADVANCED_FACE('',(#2001),#81,.F.);\n#2001 = FACE_BOUND('',#2002,.T.);\n#2002 = EDGE_LOOP('',(#96));",
+    );
+    refused(
+        &["holes", &s(&three)],
+        1,
+        &["three.step:", "EDGE_CURVE: a non-manifold edge, used 3 times by the faces #17, #93, #2000"],
+    );
     // a negative radius
     let radius =
         edited(d, "radius.step", "#31 = CYLINDRICAL_SURFACE('',#32,1.);", "#31 = CYLINDRICAL_SURFACE('',#32,-1.);");
@@ -193,6 +205,12 @@ fn bad_models_are_refused_with_the_entity_and_line() {
     // caps
     let cyl = s(&model("cylinder-open.step"));
     refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);
+    // a file over the size cap is refused before it is read (a 2 GB file alike, without
+    // writing one: the cap is checked against the file's length)
+    let big = d.join("big.step");
+    std::fs::File::create(&big).unwrap().set_len(2 << 30).unwrap();
+    refused(&["holes", &s(&big)], 1, &["big.step", "the model file's size", "--limit model="]);
+    refused(&["holes", &cyl, "--limit", "model=0"], 1, &["the model file's size", "--limit model="]);
     // usage: neither STEP nor a mesh, a missing hole, an output that is not STEP: nothing
     // written
     refused(&["holes", "model.iges"], 2, &["STEP file (.step, .stp) or a triangle mesh"]);

@@ -144,6 +144,27 @@ pub fn parse_step(source: Vec<u8>, file: &str, limits: &Limits) -> Result<StepMo
             users.entry(r).or_default().push(*id);
         }
     }
+    // a manifold model: each edge bounds at most two faces (a seam edge is one face's,
+    // run both ways)
+    let mut uses: Vec<Vec<u64>> = vec![Vec::new(); r.brep.edges.len()];
+    for f in &r.brep.faces {
+        for &(e, _) in f.loops.iter().flatten() {
+            uses[e].push(f.id);
+        }
+    }
+    if let Some((e, faces)) = uses.iter().enumerate().find(|(_, f)| f.len() > 2) {
+        let id = r.brep.edges[e].id;
+        let list: Vec<String> = faces.iter().map(|f| format!("#{f}")).collect();
+        return Err(StepError {
+            file: file.to_string(),
+            line: spans.get(&id).map(|s| s.2),
+            message: format!(
+                "#{id} EDGE_CURVE: a non-manifold edge, used {} times by the faces {} (an edge bounds at most two faces)",
+                faces.len(),
+                list.join(", ")
+            ),
+        });
+    }
     let max_id = graph.entities.keys().next_back().copied().unwrap_or(0);
     Ok(StepModel {
         file: file.to_string(),
