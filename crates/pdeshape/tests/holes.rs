@@ -53,6 +53,23 @@ fn holes_are_the_free_boundary() {
     }
 }
 
+/// The B-spline tube with two windows cut through its wall: four loops on its one face —
+/// the ends (one closed edge each: a circle of radius 1 at z = 0, 0.8 at z = 3) and the
+/// windows (four intersection curves each).
+#[test]
+fn a_tubes_windows_and_ends_are_holes_of_its_face() {
+    let t = json(&model("tube-windows.step"));
+    let h = t["holes"].as_array().unwrap();
+    let edges: Vec<usize> = h.iter().map(|x| x["edges"].as_array().unwrap().len()).collect();
+    assert_eq!(edges, [1, 1, 4, 4]);
+    assert!(h.iter().all(|x| x["faces"] == serde_json::json!([17]) && x["kind"] == "hole"));
+    // the ends: OpenCASCADE writes the loft's rims as polynomial B-splines of degree 13
+    // close to the circles (lengths measured 1.2e-9 relative off 2π and 1.6π)
+    let len = |k: usize| h[k]["length"].as_f64().unwrap();
+    let tau = std::f64::consts::TAU;
+    assert!((len(0) / tau - 1.0).abs() < 1e-8 && (len(1) / (0.8 * tau) - 1.0).abs() < 1e-8, "{} {}", len(0), len(1));
+}
+
 /// Entity texts of a STEP file's DATA section by id.
 fn entities(text: &str) -> std::collections::BTreeMap<u64, String> {
     let data = &text[text.find("DATA;").unwrap() + 5..text.rfind("ENDSEC;").unwrap()];

@@ -9,10 +9,15 @@
   its eight spherical corner faces: eight three-sided holes between cylindrical faces.
 - loft-open.step: a loft through a circle, an ellipse and a smaller circle (B-spline
   faces) without its top: one hole bounded by one closed edge on a B-spline face.
+- tube-windows.step: a B-spline tube (a loft's lateral face alone: a circle, an ellipse, a
+  smaller circle) with two windows cut through its wall by boxes: four holes on its one
+  face — the two open ends (one closed edge each) and the two windows (four edges each,
+  where the boxes cut the wall).
 
 Made by this project with OpenCASCADE; no third-party content.
 """
 
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
@@ -80,6 +85,17 @@ def main():
     loft.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 2), gp_Dir(0, 0, 1)), 0.7)))
     loft.Build()
     write(shell_without(loft.Shape(), top_plane(2.0)), "loft-open.step")
+
+    tube = BRepOffsetAPI_ThruSections(False, False)
+    tube.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0)))
+    tube.AddWire(wire(gp_Elips(gp_Ax2(gp_Pnt(0, 0, 1.5), gp_Dir(0, 0, 1)), 1.3, 0.9)))
+    tube.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 3), gp_Dir(0, 0, 1)), 0.8)))
+    tube.Build()
+    cut = tube.Shape()
+    # windows on the ±y sides, away from the face's seam (at +x)
+    for lo, hi in [((-0.35, 0.2, 0.8), (0.35, 2.0, 1.6)), ((-0.3, -2.0, 1.7), (0.3, -0.2, 2.3))]:
+        cut = BRepAlgoAPI_Cut(cut, BRepPrimAPI_MakeBox(gp_Pnt(*lo), gp_Pnt(*hi)).Shape()).Shape()
+    write(cut, "tube-windows.step")
 
 
 if __name__ == "__main__":
