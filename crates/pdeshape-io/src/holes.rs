@@ -188,8 +188,17 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
         for (k, &fi) in faces.iter().enumerate() {
             let Some(fs) = &b.faces[fi].surface else { continue };
             let field = fs.field();
-            let near = seeds[k].and_then(|c| foot_of(field.as_ref(), p, c, 0.0));
-            let Some(c) = near.or_else(|| foot_of(field.as_ref(), p, fs.invert_near(p), 0.0)) else { continue };
+            // a foot outside a B-spline face's domain (the last foot carried across a closed
+            // face's seam) is on its extrapolation, not on the face: from there moved by the
+            // period, or searched afresh
+            let settle = |start: [f64; 2]| {
+                let c = foot_of(field.as_ref(), p, start, 0.0)?;
+                if fs.in_domain(c) {
+                    return Some(c);
+                }
+                foot_of(field.as_ref(), p, fs.wrap(c), 0.0).filter(|c| fs.in_domain(*c))
+            };
+            let Some(c) = seeds[k].and_then(settle).or_else(|| settle(fs.invert_near(p))) else { continue };
             seeds[k] = Some(c);
             let dist = (field.eval(&c) - p).norm();
             if best.is_none_or(|x| dist < x.0) {

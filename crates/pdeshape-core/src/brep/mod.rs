@@ -62,6 +62,40 @@ impl FaceSurface {
         }
     }
 
+    /// Whether `c` lies in the surface's parameter domain (to 1e-6 of its extent, where
+    /// Newton's method may settle on a seam): a B-spline surface's knot ranges (beyond them
+    /// its formula extrapolates and is not the face — a foot carried across a closed face's
+    /// seam lands there); analytic surfaces have no bounds.
+    pub fn in_domain(&self, c: [f64; 2]) -> bool {
+        match self {
+            FaceSurface::Analytic(_) => c[0].is_finite() && c[1].is_finite(),
+            FaceSurface::Nurbs(n) => {
+                let ((u0, u1), (v0, v1)) = n.domain();
+                let (eu, ev) = (1e-6 * (u1 - u0), 1e-6 * (v1 - v0));
+                (u0 - eu..=u1 + eu).contains(&c[0]) && (v0 - ev..=v1 + ev).contains(&c[1])
+            }
+        }
+    }
+
+    /// `c` moved by a period into the domain in each direction in which a B-spline surface
+    /// closes on itself (its two ends' isolines meet at three points to 1e-9 of the
+    /// surface's extent); unchanged otherwise.
+    pub fn wrap(&self, c: [f64; 2]) -> [f64; 2] {
+        let FaceSurface::Nurbs(n) = self else { return c };
+        let ((u0, u1), (v0, v1)) = n.domain();
+        let scale = (n.eval(&[u0, v0]) - n.eval(&[u1, v1])).norm().max((n.eval(&[u0, v1]) - n.eval(&[u1, v0])).norm());
+        let close = |a: [f64; 2], b: [f64; 2]| (n.eval(&a) - n.eval(&b)).norm() <= 1e-9 * scale.max(1e-300);
+        let mut out = c;
+        let fr = [0.1, 0.5, 0.9];
+        if fr.iter().all(|f| close([u0, v0 + f * (v1 - v0)], [u1, v0 + f * (v1 - v0)])) {
+            out[0] = u0 + (c[0] - u0).rem_euclid(u1 - u0);
+        }
+        if fr.iter().all(|f| close([u0 + f * (u1 - u0), v0], [u0 + f * (u1 - u0), v1])) {
+            out[1] = v0 + (c[1] - v0).rem_euclid(v1 - v0);
+        }
+        out
+    }
+
     /// The unit normal `S_u × S_v / |·|` at `(u, v)` (`None` where the surface is singular).
     pub fn normal(&self, c: [f64; 2]) -> Option<Vec3> {
         let j = self.field().jet(&[c[0], c[1], 0.0], JetShape::new(&[1, 1]));
