@@ -56,6 +56,18 @@ async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
     c.perform_actions(mouse.then(PointerAction::Up { button: MOUSE_BUTTON_LEFT })).await.unwrap();
 }
 
+/// Clicks the STEP download and waits for it: its size in bytes.
+async fn step_download(c: &Client) -> u64 {
+    c.find(Locator::Css("button[data-format=step]")).await.unwrap().click().await.unwrap();
+    let d = wait_for(
+        c,
+        "the STEP download",
+        "const d = window.pdeshape.lastDownload; return d && d.name.endsWith('.step') && d.bytes",
+    )
+    .await;
+    d.as_u64().unwrap()
+}
+
 fn pos(v: &Value) -> (f64, f64) {
     (v[0].as_f64().unwrap().round(), v[1].as_f64().unwrap().round())
 }
@@ -161,14 +173,8 @@ async fn the_editor_follows_sliders_handles_and_trim_edits_in_chromium() {
     let bytes = js(&c, "return window.pdeshape.lastDownload.bytes").await;
     assert!(bytes.as_u64().unwrap() > 10_000, "{bytes}");
     // and the model as CAD geometry: measured B-spline faces in STEP
-    c.find(Locator::Css("button[data-format=step]")).await.unwrap().click().await.unwrap();
-    let d = wait_for(
-        &c,
-        "the STEP download",
-        "const d = window.pdeshape.lastDownload; return d && d.name.endsWith('.step') && d.bytes",
-    )
-    .await;
-    assert!(d.as_u64().unwrap() > 10_000, "{d}");
+    let d = step_download(&c).await;
+    assert!(d > 10_000, "{d}");
     c.close().await.unwrap();
 }
 
@@ -239,14 +245,8 @@ async fn the_editor_opens_a_step_model_and_fills_a_clicked_hole_in_chromium() {
     assert_ne!(shot0, shot1, "the picture did not change after the fill");
 
     // the STEP download is the model with the fill sewn in (the input is 49 929 bytes)
-    c.find(Locator::Css("button[data-format=step]")).await.unwrap().click().await.unwrap();
-    let d = wait_for(
-        &c,
-        "the STEP download",
-        "const d = window.pdeshape.lastDownload; return d && d.name.endsWith('.step') && d.bytes",
-    )
-    .await;
-    assert!(d.as_u64().unwrap() > 49_929, "{d}");
+    let d = step_download(&c).await;
+    assert!(d > 49_929, "{d}");
     c.close().await.unwrap();
 }
 

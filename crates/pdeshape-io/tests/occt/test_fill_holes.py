@@ -86,16 +86,10 @@ def seams(shape, new, samples=12):
     return gap, angle, kgap
 
 
-@pytest.mark.parametrize("order", [4, 6])
-@pytest.mark.parametrize("name", sorted(MODELS))
-def test_filled_model_is_a_valid_solid_with_its_faces_unchanged(name, order, models, tmp_path):
-    src = models / f"{name}.step"
-    out = tmp_path / "filled.step"
-    r = subprocess.run(
-        [cli(), "fill-holes", str(src), "-o", str(out), "--order", str(order)], capture_output=True, text=True, timeout=600
-    )
-    assert r.returncode == 0, r.stderr
-    before, after = read(src), read(out)
+def closed_with_new_faces(before, after, added):
+    """Checks that `after` is one valid solid without free edges whose first faces are
+    `before`'s, in their order and unchanged (type, area), followed by `added` new ones;
+    the largest gap, normal angle and curvature difference across the new faces' edges."""
     assert BRepCheck_Analyzer(after).IsValid()
     ex = TopExp_Explorer(after, TopAbs_SOLID)
     solids = 0
@@ -106,12 +100,24 @@ def test_filled_model_is_a_valid_solid_with_its_faces_unchanged(name, order, mod
     free = [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)]
     assert free == []
     fb, fa = faces(before), faces(after)
-    assert len(fa) == len(fb) + MODELS[name]
-    # the input's faces come first, in their order, unchanged
+    assert len(fa) == len(fb) + added
     for x, y in zip(fb, fa):
         assert BRepAdaptor_Surface(x).GetType() == BRepAdaptor_Surface(y).GetType()
         assert abs(area(x) - area(y)) <= 1e-9 * area(x)
-    gap, angle, kgap = seams(after, fa[len(fb):])
+    return seams(after, fa[len(fb):])
+
+
+@pytest.mark.parametrize("order", [4, 6])
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_filled_model_is_a_valid_solid_with_its_faces_unchanged(name, order, models, tmp_path):
+    src = models / f"{name}.step"
+    out = tmp_path / "filled.step"
+    r = subprocess.run(
+        [cli(), "fill-holes", str(src), "-o", str(out), "--order", str(order)], capture_output=True, text=True, timeout=600
+    )
+    assert r.returncode == 0, r.stderr
+    before, after = read(src), read(out)
+    gap, angle, kgap = closed_with_new_faces(before, after, MODELS[name])
     # the fit holds each new face (degree 5) to 1e-7 of the model's size (~3.5): measured
     # gaps ≤ 6.6e-8, angles ≤ 1.3e-6 rad at order 4 and ≤ 1.1e-6 rad at order 6
     assert gap < 3e-7, gap
@@ -133,20 +139,7 @@ def test_scene_importing_the_box_closes_it(models, tmp_path):
     r = subprocess.run([cli(), "build", str(scene), "-o", str(out)], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     before, after = read(tmp_path / "rounded-box-corners.step"), read(out)
-    assert BRepCheck_Analyzer(after).IsValid()
-    ex = TopExp_Explorer(after, TopAbs_SOLID)
-    solids = 0
-    while ex.More():
-        solids += 1
-        ex.Next()
-    assert solids == 1
-    assert [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)] == []
-    fb, fa = faces(before), faces(after)
-    assert len(fa) == len(fb) + 8
-    for x, y in zip(fb, fa):
-        assert BRepAdaptor_Surface(x).GetType() == BRepAdaptor_Surface(y).GetType()
-        assert abs(area(x) - area(y)) <= 1e-9 * area(x)
-    gap, angle, _ = seams(after, fa[len(fb):])
+    gap, angle, _ = closed_with_new_faces(before, after, 8)
     # as fill-holes on this model (fit to 1e-7 of the size ~3.5; fill-holes measured
     # 2.7e-13 and 1.6e-8 rad at order 4)
     assert gap < 3e-7, gap
