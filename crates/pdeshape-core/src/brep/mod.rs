@@ -83,8 +83,13 @@ impl FaceSurface {
     pub fn wrap(&self, c: [f64; 2]) -> [f64; 2] {
         let FaceSurface::Nurbs(n) = self else { return c };
         let ((u0, u1), (v0, v1)) = n.domain();
-        let scale = (n.eval(&[u0, v0]) - n.eval(&[u1, v1])).norm().max((n.eval(&[u0, v1]) - n.eval(&[u1, v0])).norm());
-        let close = |a: [f64; 2], b: [f64; 2]| (n.eval(&a) - n.eval(&b)).norm() <= 1e-9 * scale.max(1e-300);
+        let scale = crate::num::max_nan(
+            (n.eval(&[u0, v0]) - n.eval(&[u1, v1])).norm(),
+            (n.eval(&[u0, v1]) - n.eval(&[u1, v0])).norm(),
+        );
+        // a NaN scale closes nothing
+        let close =
+            |a: [f64; 2], b: [f64; 2]| (n.eval(&a) - n.eval(&b)).norm() <= 1e-9 * crate::num::max_nan(scale, 1e-300);
         let mut out = c;
         let fr = [0.1, 0.5, 0.9];
         if fr.iter().all(|f| close([u0, v0 + f * (v1 - v0)], [u1, v0 + f * (v1 - v0)])) {

@@ -23,6 +23,7 @@ use crate::Vec3;
 use crate::fill::foot_of;
 use crate::jet::JetShape;
 use crate::mesh::Mesh;
+use crate::num::max_nan;
 
 /// Points sampled on each edge of a loop.
 pub const PER_EDGE: usize = 24;
@@ -89,7 +90,7 @@ pub fn face_mesh(b: &Brep, face: usize, target: f64) -> Result<Mesh, TessellateE
     for t in &tris {
         for k in 0..3 {
             let (a, b) = (poly[t[k]], poly[t[(k + 1) % 3]]);
-            longest = longest.max((field.eval(&[a[0], a[1], 0.0]) - field.eval(&[b[0], b[1], 0.0])).norm());
+            longest = max_nan(longest, (field.eval(&[a[0], a[1], 0.0]) - field.eval(&[b[0], b[1], 0.0])).norm());
         }
     }
     let k = if target > 0.0 { ((longest / target).ceil() as usize).clamp(1, 24) } else { 1 };
@@ -147,8 +148,10 @@ fn loop_parameters(
     }
     // closed: the walk comes back to its start (not a period away)
     if let (Some(first), Some(last)) = (out.first(), out.last()) {
-        let step = out.windows(2).map(|w| dist(w[0], w[1])).fold(0.0, f64::max);
-        if dist(*first, *last) > 4.0 * step.max(1e-12) {
+        let step = out.windows(2).map(|w| dist(w[0], w[1])).fold(0.0, max_nan);
+        // a NaN step or gap counts as not closed
+        let gap = dist(*first, *last);
+        if gap.is_nan() || step.is_nan() || gap > 4.0 * max_nan(step, 1e-12) {
             return Err(TessellateError::Open(face));
         }
     }
@@ -213,7 +216,7 @@ fn bridged(poly: &[[f64; 2]], h: &[[f64; 2]], holes: &[Vec<[f64; 2]>]) -> Option
 fn ear_clip(p: &[[f64; 2]]) -> Option<Vec<[usize; 3]>> {
     let mut idx: Vec<usize> = (0..p.len()).collect();
     let mut out = Vec::with_capacity(p.len());
-    let scale = p.iter().fold(0.0_f64, |a, q| a.max(q[0].abs()).max(q[1].abs())).max(1e-300);
+    let scale = max_nan(p.iter().fold(0.0_f64, |a, q| max_nan(max_nan(a, q[0].abs()), q[1].abs())), 1e-300);
     let eps = 1e-14 * scale * scale;
     while idx.len() > 3 {
         let n = idx.len();

@@ -84,7 +84,7 @@ pub(super) fn build_fill(
     let mut list = Vec::new();
     // the imported edges used, by import (to find the hole they close) and how far the
     // file's edges lie off their faces
-    let mut imported: Vec<(String, HoleUse)> = Vec::new();
+    let mut imported: Vec<Option<(String, HoleUse)>> = Vec::new();
     let mut edge_offset: f64 = 0.0;
     if let Some(h) = &rp.hole {
         let hk = format!("{key}.hole");
@@ -94,7 +94,7 @@ pub(super) fn build_fill(
             let p = edge_pieces(&imp.model.model.brep, u, cuts, 0.0).map_err(|e| ctx.err(span(h), &hk, e.to_string()))?;
             edge_offset = max_nan(edge_offset, p.offset);
             list.extend(p.edges.into_iter().map(|e| FillEdge { fullness, ..e }));
-            imported.push((imp.name.clone(), *u));
+            imported.push(Some((imp.name.clone(), *u)));
         }
     }
     let no_edges = Vec::new();
@@ -137,11 +137,11 @@ pub(super) fn build_fill(
                 .map_err(|err| ctx.err(span(e), &ek, err.to_string()))?;
             edge_offset = max_nan(edge_offset, p.offset);
             list.extend(p.edges.into_iter().map(|e| FillEdge { fullness: f, ..e }));
-            imported.push((imp.name.clone(), u));
+            imported.push(Some((imp.name.clone(), u)));
             continue;
         }
         chain = None;
-        imported.push((String::new(), HoleUse { edge: usize::MAX, forward: true, face: usize::MAX }));
+        imported.push(None);
         if let Some(f) = &re.face {
             return Err(ctx.err(span(f), format!("{ek}.face"), "`face` names the face of an imported `edge`"));
         }
@@ -248,8 +248,9 @@ pub(super) fn build_fill(
 }
 
 /// The import and the number (from 1) of the hole whose loop is exactly the edges `used`
-/// (each with the import's name; an empty name for an edge not imported), if any.
-fn closed_hole(imports: &[SceneImport], used: &[(String, HoleUse)]) -> Option<(String, usize)> {
+/// (each with the import's name; `None` for an edge not imported), if any.
+fn closed_hole(imports: &[SceneImport], used: &[Option<(String, HoleUse)>]) -> Option<(String, usize)> {
+    let used: Vec<&(String, HoleUse)> = used.iter().map(Option::as_ref).collect::<Option<Vec<_>>>()?;
     let name = &used.first()?.0;
     if used.iter().any(|(n, _)| n != name) {
         return None;
