@@ -9,7 +9,7 @@ use crate::import::step::StepModel;
 use pdeshape_core::Vec3;
 use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleKind, fill_hole};
 use pdeshape_core::fill::{Fill, FillOptions, foot_of};
-use pdeshape_core::fit::{BSplineSurface, FitOptions, FitReport, fit_surface};
+use pdeshape_core::fit::{BSplineSurface, EdgeTolerance, FitOptions, FitReport, fit_surface};
 use pdeshape_core::num::max_nan;
 use serde::Serialize;
 use std::path::Path;
@@ -152,22 +152,10 @@ pub struct SeamFigures {
     pub samples: usize,
 }
 
-/// The normal curvature `II(t̂, t̂) / I(t̂, t̂)` of a surface in the direction `t` (in its
-/// tangent plane; `t̂ = a S_u + b S_v` its coordinates) and the unit normal, from the
-/// derivatives `d` in the order of `BSplineSurface::derivatives(…, 2, 2)`: index `3i + k`
-/// for `∂uⁱ∂vᵏS`.
+/// The normal curvature in the direction `t` and the unit normal from derivatives `d` in
+/// the order of `BSplineSurface::derivatives(…, 2, 2)` (index `3i + k` for `∂uⁱ∂vᵏS`).
 fn normal_curvature(d: &[Vec3], t: Vec3) -> Option<(f64, Vec3)> {
-    let (su, sv) = (d[3], d[1]);
-    let n = su.cross(sv).normalized()?;
-    // t = a S_u + b S_v
-    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
-    let det = e * g - f * f;
-    let (tu, tv) = (t.dot(su), t.dot(sv));
-    let a = (g * tu - f * tv) / det;
-    let b = (e * tv - f * tu) / det;
-    let second = d[6] * (a * a) + d[4] * (2.0 * a * b) + d[2] * (b * b);
-    let first = (su * a + sv * b).dot(su * a + sv * b);
-    Some((second.dot(n) / first, n))
+    pdeshape_core::fit::normal_curvature(d[3], d[1], d[6], d[4], d[2], t)
 }
 
 /// The continuity of `s` (its `u = 0` side) against the faces `faces` of `b` (whose size
@@ -269,10 +257,20 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
     Ok(out)
 }
 
+/// What the written face's edge along its hole is fitted to (against the fill, which
+/// meets the faces around to round-off): gap 3e-10 of the model's size, normals within
+/// 3e-9 rad, and at order 6 the normal curvature across the edge within 3e-7 of
+/// `max(|κ|, 1 / size)` — a third of what the faces are measured against afterwards
+/// (gap 1e-9, 1e-8 rad, 1e-6), since the fit's check samples where the final measure
+/// lands elsewhere.
+pub fn seam_tolerance(order: usize, size: f64) -> EdgeTolerance {
+    EdgeTolerance { gap: 3e-10 * size, angle: 3e-9, curvature: (order >= 6).then_some(3e-7), scale: size }
+}
+
 /// Fits the fill `fill` (of order `order`) of hole `index` (from 1) of `m` by a B-spline
 /// face of degree 5 (interpolating the fill's first and second cross derivatives along the
-/// loop) to `relative` of the model's size, and
-/// measures the seam of the face against the faces around.
+/// loop) to `relative` of the model's size, its edge along the loop to [`seam_tolerance`],
+/// and measures the seam of the face against the faces around.
 pub fn fit_filled(
     m: &StepModel,
     holes: &[Hole],
@@ -293,6 +291,10 @@ pub fn fit_filled(
         tolerance: Some(relative * size),
         degree,
         v_breaks: fill.corner_parameters(),
+        edge: Some(seam_tolerance(order, size)),
+        // the edge's tolerances take up to ~490 points along the loop (a rounded box's
+        // corner at order 6: its corner blends are polynomials of degree 7 in v)
+        max_points: 1000,
         ..Default::default()
     };
     let (surface, fit) = fit_surface(fill.patch().as_ref(), &fo).map_err(|e| fail(e.to_string()))?;

@@ -23,9 +23,11 @@
 
 mod basis;
 mod curve;
+mod edge;
 
 pub use basis::Knots;
 pub use curve::{BSplineCurve3, fit_curve};
+pub use edge::{EdgeTolerance, normal_curvature};
 
 use crate::Vec3;
 use crate::patch::Surface;
@@ -123,6 +125,11 @@ pub struct FitOptions {
     /// Interior `u` breakpoints to start from instead of `spans.0` uniform spans (the
     /// faces of a solid, which meet along edges in either direction).
     pub u_start: Vec<f64>,
+    /// Tolerances for the `u = 0` edge (gap, normal angle, normal curvature across it
+    /// against the patch's own), met first by refining the `v` knots (see [`EdgeTolerance`]
+    /// and the module `edge`); `None`: the edge is only as good as the surface tolerance
+    /// makes it.
+    pub edge: Option<EdgeTolerance>,
 }
 
 impl Default for FitOptions {
@@ -136,6 +143,7 @@ impl Default for FitOptions {
             v_breaks: Vec::new(),
             v_start: Vec::new(),
             u_start: Vec::new(),
+            edge: None,
         }
     }
 }
@@ -657,6 +665,10 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
         iv.sort_by(f64::total_cmp);
         iv.dedup();
         ax.interior = iv;
+    }
+    if let Some(t) = &o.edge {
+        let ax = &mut axes[1];
+        ax.interior = edge::edge_breakpoints(s, p, (ax.lo, ax.hi), ax.interior.clone(), &ax.c0, t, o.max_points)?;
     }
     let mut samples = 0;
     for round in 1.. {

@@ -157,3 +157,64 @@ fn quintic_faces_meet_the_tolerance_and_interpolate_the_second_cross_derivative(
         }
     }
 }
+
+/// A wavy band `X = ((1 + u) cos v, (1 + u) sin v, 0.2 (1 + u) sin 5v + u² cos 3v)` (periodic
+/// `v`; derivatives by hand: `∂ⱼ cos v = cos(v + jπ/2)`, `∂ⱼ sin 5v = 5ʲ sin(5v + jπ/2)`).
+struct Band;
+
+impl crate::patch::Surface for Band {
+    fn v_domain(&self) -> crate::patch::VDomain {
+        crate::patch::VDomain::PERIODIC
+    }
+    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+        let h = std::f64::consts::FRAC_PI_2;
+        let mut out = Vec::new();
+        for i in 0..=du {
+            for j in 0..=dv {
+                let lin = [1.0 + u, 1.0, 0.0][i.min(2)];
+                let sq = [u * u, 2.0 * u, 2.0, 0.0][i.min(3)];
+                let jf = j as f64;
+                let (c, s) = ((v + jf * h).cos(), (v + jf * h).sin());
+                let z = 0.2 * lin * 5f64.powi(j as i32) * (5.0 * v + jf * h).sin()
+                    + sq * 3f64.powi(j as i32) * (3.0 * v + jf * h).cos();
+                out.push(Vec3::new(lin * c, lin * s, z));
+            }
+        }
+        out
+    }
+}
+
+/// The `u = 0` edge of a fit with [`EdgeTolerance`]: gap, normal angle and normal
+/// curvature across the edge against the band's own, at 2000 points of the edge that are
+/// not samples of the check, within the tolerances (the check samples 8 points a span; the
+/// random points may land a little higher: 1.5×). The same fit without the edge tolerance
+/// misses the angle by far (it only bounds positions), so the test can fail.
+#[test]
+fn the_edge_meets_its_own_gap_angle_and_curvature_tolerances() {
+    let tol = EdgeTolerance { gap: 1e-12, angle: 1e-10, curvature: Some(1e-8), scale: 2.0 };
+    let base = FitOptions { tolerance: Some(1e-6), degree: 5, ..Default::default() };
+    let (plain, _) = fit_surface(&Band, &base).unwrap();
+    let (tight, r) = fit_surface(&Band, &FitOptions { edge: Some(tol), max_points: 1000, ..base.clone() }).unwrap();
+    assert!(r.max_deviation <= 1e-6, "{r:?}");
+    let figures = |b: &BSplineSurface| {
+        let (mut gap, mut angle, mut curv) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for (_, v) in points(2000, 0.0, std::f64::consts::TAU) {
+            let d = b.derivatives(0.0, v, 2, 2); // index 3i + k: ∂uⁱ∂vᵏ
+            let x = Band.derivatives(0.0, v, 2, 2);
+            let along = x[1].normalized().unwrap();
+            let across = x[3] - along * x[3].dot(along);
+            let (ks, ns) = normal_curvature(d[3], d[1], d[6], d[4], d[2], across).unwrap();
+            let (kx, nx) = normal_curvature(x[3], x[1], x[6], x[4], x[2], across).unwrap();
+            gap = crate::num::max_nan(gap, (d[0] - x[0]).norm());
+            angle = crate::num::max_nan(angle, ns.cross(nx).norm().atan2(ns.dot(nx)));
+            curv = crate::num::max_nan(curv, (ks - kx).abs() / crate::num::max_nan(kx.abs(), 1.0 / tol.scale));
+        }
+        (gap, angle, curv)
+    };
+    let (gap, angle, curv) = figures(&tight);
+    eprintln!("edge-fitted: {:?} points, gap {gap:.2e}, angle {angle:.2e}, curvature {curv:.2e}", r.points);
+    assert!(gap <= 1.5 * tol.gap && angle <= 1.5 * tol.angle && curv <= 1.5 * 1e-8, "{gap} {angle} {curv}");
+    let (pg, pa, pc) = figures(&plain);
+    eprintln!("plain: gap {pg:.2e}, angle {pa:.2e}, curvature {pc:.2e}");
+    assert!(pa > 100.0 * tol.angle && pc > 100.0 * 1e-8, "{pa} {pc}");
+}
