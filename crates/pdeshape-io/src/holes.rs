@@ -282,6 +282,18 @@ pub fn fit_filled(
 ) -> Result<FilledHole, String> {
     let fail = |e: String| format!("hole {index}: {e}");
     let h = holes.get(index.wrapping_sub(1)).ok_or_else(|| fail("no such hole".into()))?;
+    // a fill whose parametrisation turns over would be written as a face folded onto
+    // itself (OpenCASCADE reads such a solid as invalid, of negative volume): e.g. the rim
+    // of a removed boss's wall, where the face around turns away from the loop — a gap
+    // between two loops, not a hole one cap closes
+    let (nu, nv) = (41, 200);
+    let folds = fill.turn_overs(nu, nv);
+    if folds > 0 {
+        return Err(fail(format!(
+            "the fill folds over ({folds} of {} points of a {nu} × {nv} grid turn its normal by more than 120°): the faces around turn away from the hole, which no cap closes without folding; not filled",
+            nu * nv
+        )));
+    }
     let size = m.brep.size();
     // degree 5 at both orders: against degree 3 at order 4 it needs fewer control points
     // (cylinder 9 × 31 against 19 × 79), leaves the seam's angle 4–25× smaller and takes

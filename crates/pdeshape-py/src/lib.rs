@@ -995,12 +995,22 @@ fn model_error(e: impl std::fmt::Display) -> PyErr {
 /// bounding box and the angle between the faces at each corner; for a triangle mesh
 /// (.obj, .ply, .stl) its boundary loops with their edge counts, lengths and boxes.
 ///
+/// `replace_faces` (STEP models): faces taken out first, by their `#id`s; the loops they
+/// leave are listed as holes.
+///
 /// >>> pdeshape.holes("part.step")["holes"][0]["edges"]
 /// [21]
 #[pyfunction]
-#[pyo3(signature = (path, *, limits=None))]
-fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyAny>> {
+#[pyo3(signature = (path, *, replace_faces=None, limits=None))]
+fn holes(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    replace_faces: Option<Vec<u64>>,
+    limits: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
     let limits = limits_of(limits)?;
+    let replace = replace_faces.unwrap_or_default();
+    no_faces_in_a_mesh(&path, &replace)?;
     let report = pool::detached(py, || -> Result<serde_json::Value, String> {
         if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
             let mf = pdeshape_io::import::mesh::read_mesh(&path, &limits).map_err(|e| e.to_string())?;
@@ -1008,11 +1018,35 @@ fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyD
             return serde_json::to_value(pdeshape_io::mesh_holes::mesh_holes_report(&mf, &loops))
                 .map_err(|e| e.to_string());
         }
-        let m = pdeshape_io::import::step::read_step(&path, &limits).map_err(|e| e.to_string())?;
+        let m = read_without(&path, &replace, &limits)?;
         let hs = pdeshape_core::brep::holes(&m.brep);
         serde_json::to_value(pdeshape_io::holes::holes_report(&m, &hs)).map_err(|e| e.to_string())
     });
     to_python(py, &report.map_err(model_error)?)
+}
+
+/// The STEP model at `path` without the faces `replace` (by `#id`).
+fn read_without(
+    path: &std::path::Path,
+    replace: &[u64],
+    limits: &pdeshape_core::limits::Limits,
+) -> Result<pdeshape_io::import::step::StepModel, String> {
+    let m = pdeshape_io::import::step::read_step(path, limits).map_err(|e| e.to_string())?;
+    if replace.is_empty() {
+        return Ok(m);
+    }
+    m.without_faces(replace).map_err(|e| e.to_string())
+}
+
+/// `replace_faces` names faces of a STEP model: a mesh has none.
+fn no_faces_in_a_mesh(path: &std::path::Path, replace: &[u64]) -> PyResult<()> {
+    if !replace.is_empty() && pdeshape_io::import::mesh::MeshFormat::from_path(path).is_some() {
+        return Err(PyValueError::new_err(format!(
+            "{}: replace_faces takes faces of a STEP model; a triangle mesh has none",
+            path.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Fills holes with fills of order 4 (G1) or 6 (G2), as `pdeshape fill-holes` does.
@@ -1026,11 +1060,12 @@ fn holes(py: Python<'_>, path: std::path::PathBuf, limits: Option<&Bound<'_, PyD
 ///   fills' rows after them.
 ///
 /// `holes` picks holes by their numbers in `pdeshape.holes` (from 1); `max_edges` leaves
-/// bigger loops open. Raises `ModelError` when the model cannot be read or an asked hole
+/// bigger loops open; `replace_faces` (STEP models) takes faces out first, by their
+/// `#id`s, so that fills replace them. Raises `ModelError` when the model cannot be read or an asked hole
 /// cannot be filled (nothing is written), `ValueError` for arrays of the wrong shape or
 /// indices out of range, `TimeoutError` past `time_limit` seconds.
 #[pyfunction]
-#[pyo3(signature = (model, out, *, order=4, holes=None, max_edges=None, relative_tolerance=1e-7, limits=None, time_limit=None))]
+#[pyo3(signature = (model, out, *, order=4, holes=None, max_edges=None, relative_tolerance=1e-7, replace_faces=None, limits=None, time_limit=None))]
 #[allow(clippy::too_many_arguments)]
 fn fill_holes(
     py: Python<'_>,
@@ -1040,6 +1075,7 @@ fn fill_holes(
     holes: Option<Vec<usize>>,
     max_edges: Option<usize>,
     relative_tolerance: f64,
+    replace_faces: Option<Vec<u64>>,
     limits: Option<&Bound<'_, PyDict>>,
     time_limit: Option<f64>,
 ) -> PyResult<Py<PyAny>> {
@@ -1055,9 +1091,14 @@ fn fill_holes(
         return Err(PyValueError::new_err("holes and max_edges do not go together: holes picks the holes itself"));
     }
     let o = pdeshape_io::holes::FillHolesOptions { order, holes, max_edges, relative: relative_tolerance };
+    let replace = replace_faces.unwrap_or_default();
     let Ok(path) = model.extract::<std::path::PathBuf>() else {
+        if !replace.is_empty() {
+            return Err(PyValueError::new_err("replace_faces takes faces of a STEP model; a mesh has none"));
+        }
         return fill_mesh_arrays(py, model, out, &o, &limits, seconds);
     };
+    no_faces_in_a_mesh(&path, &replace)?;
     let out: std::path::PathBuf = out.extract()?;
     let done = limited(py, seconds, "filling the holes", || -> Result<serde_json::Value, String> {
         if pdeshape_io::import::mesh::MeshFormat::from_path(&path).is_some() {
@@ -1071,7 +1112,7 @@ fn fill_holes(
             pdeshape_io::mesh_holes::write_trimesh(&out, &filled)?;
             return serde_json::to_value(&reports).map_err(|e| e.to_string());
         }
-        let m = pdeshape_io::import::step::read_step(&path, &limits).map_err(|e| e.to_string())?;
+        let m = read_without(&path, &replace, &limits)?;
         let hs = pdeshape_core::brep::holes(&m.brep);
         let filled = pdeshape_io::holes::fill_holes(&m, &hs, &o).map_err(|e| format!("{}: {e}", m.file))?;
         if filled.is_empty() {

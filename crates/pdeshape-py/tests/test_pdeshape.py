@@ -322,6 +322,22 @@ def test_holes_and_fill_holes_of_a_step_model(tmp_path):
     assert pdeshape.holes(out)["holes"] == []
 
 
+def test_a_replaced_face_of_a_step_model(tmp_path):
+    """``replace_faces``: the cylinder's bottom disc (#93) out, both rims are holes of the
+    wall (#17); filled, the written model has none left. A mesh has no faces to replace."""
+    r = pdeshape.holes(STEP / "cylinder-open.step", replace_faces=[93])
+    assert [h["faces"] for h in r["holes"]] == [[17], [17]]
+    out = tmp_path / "closed.step"
+    done = pdeshape.fill_holes(STEP / "cylinder-open.step", out, replace_faces=[93])
+    assert [d["index"] for d in done] == [1, 2]
+    assert pdeshape.holes(out)["holes"] == []
+    with pytest.raises(pdeshape.ModelError, match="#31 is a"):
+        pdeshape.holes(STEP / "cylinder-open.step", replace_faces=[31])
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    with pytest.raises(ValueError, match="a mesh has none"):
+        pdeshape.fill_holes(v, np.array([[0, 1, 2]]), replace_faces=[1])
+
+
 def test_scene_importing_a_step_model(tmp_path, monkeypatch):
     """`[import.NAME] step = …` in a scene loaded from Python: paths relative to the scene
     file (Scene.load) or to the current directory (from_toml); the hole's fill lies on the

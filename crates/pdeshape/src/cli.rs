@@ -112,6 +112,11 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// STEP models: take these faces out first (their `#id`s, as `holes` names the
+        /// faces around each hole), so that the loops they leave are holes — a face to be
+        /// replaced by a fill.
+        #[arg(long, value_delimiter = ',')]
+        replace_faces: Vec<u64>,
     },
     /// Fill the holes of a model with fills of order 4 (G1) or 6 (G2) and write it back
     /// with the fills sewn in: a STEP model with new faces (every input face unchanged), a
@@ -136,6 +141,11 @@ enum Command {
         /// model's size (default 1e-7).
         #[arg(long, value_parser = positive)]
         relative_tolerance: Option<f64>,
+        /// STEP models: take these faces out first (their `#id`s, as `holes` names the
+        /// faces around each hole), so that the loops they leave are holes — a face to be
+        /// replaced by a fill.
+        #[arg(long, value_delimiter = ',')]
+        replace_faces: Vec<u64>,
     },
     /// Render a scene, or a triangle mesh (.obj, .ply, .stl), to PNG.
     Render {
@@ -475,13 +485,13 @@ fn execute(cli: Cli, limits: Limits) -> Result<()> {
             }
             Ok(())
         }
-        Command::Holes { model, json } => crate::holes::list(&model, json, &limits),
-        Command::FillHoles { model, out, order, holes, max_edges, relative_tolerance } => {
+        Command::Holes { model, json, replace_faces } => crate::holes::list(&model, json, &replace_faces, &limits),
+        Command::FillHoles { model, out, order, holes, max_edges, relative_tolerance, replace_faces } => {
             let mut o = pdeshape_io::holes::FillHolesOptions { order, holes, max_edges, ..Default::default() };
             if let Some(r) = relative_tolerance {
                 o.relative = r;
             }
-            crate::holes::fill(&model, &out, &o, &limits, quiet)
+            crate::holes::fill(&model, &out, &o, &replace_faces, &limits, quiet)
         }
         Command::Gallery { dir } => crate::gallery::run(&dir, quiet, limits),
         Command::Bench { scaling: Some(dir), runs, max_side, .. } => {

@@ -18,8 +18,22 @@ fn is_step(p: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("step") || e.eq_ignore_ascii_case("stp"))
 }
 
-fn load(path: &Path, limits: &Limits) -> Result<StepModel> {
-    Ok(read_step(path, limits)?)
+/// The STEP model at `path` without the faces `replace` (by `#id`).
+fn load(path: &Path, replace: &[u64], limits: &Limits) -> Result<StepModel> {
+    let m = read_step(path, limits)?;
+    if replace.is_empty() {
+        return Ok(m);
+    }
+    Ok(m.without_faces(replace)?)
+}
+
+/// `--replace-faces` names faces of a STEP model: a mesh has none.
+fn no_faces_to_replace(path: &Path, replace: &[u64]) -> Result<()> {
+    if replace.is_empty() {
+        return Ok(());
+    }
+    Err(Usage(format!("{}: --replace-faces takes faces of a STEP model; a triangle mesh has none", path.display()))
+        .into())
 }
 
 /// The kind of a model file, from its extension.
@@ -37,12 +51,13 @@ fn kind(path: &Path) -> Result<Option<MeshFormat>> {
     }
 }
 
-/// `pdeshape holes MODEL [--json]`.
-pub fn list(path: &Path, json: bool, limits: &Limits) -> Result<()> {
+/// `pdeshape holes MODEL [--json] [--replace-faces ID,…]`.
+pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result<()> {
     if kind(path)?.is_some() {
+        no_faces_to_replace(path, replace)?;
         return list_mesh(path, json, limits);
     }
-    let m = load(path, limits)?;
+    let m = load(path, replace, limits)?;
     let hs = holes(&m.brep);
     let r = holes_report(&m, &hs);
     if json {
@@ -86,15 +101,24 @@ pub fn list(path: &Path, json: bool, limits: &Limits) -> Result<()> {
     Ok(())
 }
 
-/// `pdeshape fill-holes MODEL -o OUT [--order 4|6] [--holes I,J | --max-edges N]`.
-pub fn fill(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, quiet: bool) -> Result<()> {
+/// `pdeshape fill-holes MODEL -o OUT [--order 4|6] [--holes I,J | --max-edges N]
+/// [--replace-faces ID,…]`.
+pub fn fill(
+    path: &Path,
+    out: &Path,
+    o: &FillHolesOptions,
+    replace: &[u64],
+    limits: &Limits,
+    quiet: bool,
+) -> Result<()> {
     if kind(path)?.is_some() {
+        no_faces_to_replace(path, replace)?;
         return fill_mesh(path, out, o, limits, quiet);
     }
     if !is_step(out) {
         return Err(Usage(format!("{}: the output must be a STEP file (.step or .stp)", out.display())).into());
     }
-    let m = load(path, limits)?;
+    let m = load(path, replace, limits)?;
     let hs = holes(&m.brep);
     let filled = fill_holes(&m, &hs, o).map_err(|e| anyhow!("{}: {e}", m.file))?;
     if filled.is_empty() {

@@ -395,3 +395,72 @@ fn a_scene_importing_a_model_builds_it_back_with_its_fills() {
     );
     assert!(!c.exists());
 }
+
+/// `--replace-faces`: the cylinder's bottom disc (#93) taken out leaves both rims as holes;
+/// filled, the shell lists the wall and the two new faces but not the disc, is closed, and
+/// the surface model is a solid; every other entity is written back as it was. Replacing
+/// the two new faces of that closed result and filling one of the two holes they leave is
+/// refused (the closed shell would be open), as is a cap on the disc without its wall (it
+/// would fold); an id that is not a face is refused by name; a mesh has no faces to
+/// replace (usage).
+#[test]
+fn a_replaced_face_leaves_holes_that_are_filled() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = model("cylinder-open.step");
+    let o = run(&["holes", input.to_str().unwrap(), "--json", "--replace-faces", "93"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let hs = j["holes"].as_array().unwrap();
+    assert_eq!(hs.len(), 2, "{j}");
+    for h in hs {
+        assert_eq!(h["faces"].as_array().unwrap(), &vec![serde_json::json!(17)], "{h}");
+        // each rim a circle of radius 1
+        assert!((h["length"].as_f64().unwrap() - std::f64::consts::TAU).abs() < 1e-12, "{h}");
+    }
+    let out = dir.path().join("closed.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--replace-faces", "93"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let before = entities(&std::fs::read_to_string(&input).unwrap());
+    let after = entities(&std::fs::read_to_string(&out).unwrap());
+    let changed: Vec<u64> = before.iter().filter(|(id, body)| after.get(id) != Some(body)).map(|(id, _)| *id).collect();
+    // the shell, the surface model (now a solid) and its representation
+    assert_eq!(changed, vec![10, 15, 16], "{err}");
+    assert!(after[&16].starts_with("CLOSED_SHELL('',(#17,#") && !after[&16].contains("#93"), "{}", after[&16]);
+    assert_eq!(after[&15], "MANIFOLD_SOLID_BREP('',#16)");
+    assert_eq!(after[&16].matches('#').count(), 3);
+    assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
+    for (gap, angle) in figures(&err) {
+        assert!(gap < 3.5e-9 && angle < 1e-8, "{err}");
+    }
+    // the closed result without its two new faces: both rims are holes again, and
+    // filling only one would leave the closed shell open
+    let new_faces: Vec<String> = after
+        .iter()
+        .filter(|(id, b)| b.starts_with("ADVANCED_FACE") && ![17, 93].contains(*id))
+        .map(|(id, _)| id.to_string())
+        .collect();
+    assert_eq!(new_faces.len(), 2);
+    let half = dir.path().join("half.step");
+    let (o, h) = (out.to_str().unwrap(), half.to_str().unwrap());
+    let o = run(&["fill-holes", o, "-o", h, "--replace-faces", &new_faces.join(","), "--holes", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("#16 CLOSED_SHELL") && err.contains("not every hole"), "{err}");
+    assert!(!half.exists());
+    // without its wall the disc's rim is the only loop, and the disc turns away from it
+    // (outwards): a cap on it folds onto itself (OpenCASCADE read such a face as invalid,
+    // of negative volume, on an NX part's boss), so it is refused, nothing written
+    let folded = dir.path().join("folded.step");
+    refused(
+        &["fill-holes", input.to_str().unwrap(), "-o", folded.to_str().unwrap(), "--replace-faces", "17"],
+        1,
+        &["hole 1: the fill folds over", "not filled"],
+    );
+    assert!(!folded.exists());
+    refused(&["holes", input.to_str().unwrap(), "--replace-faces", "31"], 1, &["#31 is a", "not a face"]);
+    refused(&["holes", input.to_str().unwrap(), "--replace-faces", "99999"], 1, &["#99999 is no entity"]);
+    let mesh = dir.path().join("m.obj");
+    std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    refused(&["holes", mesh.to_str().unwrap(), "--replace-faces", "3"], 2, &["a triangle mesh has none"]);
+}

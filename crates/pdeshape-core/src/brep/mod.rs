@@ -215,6 +215,30 @@ pub struct Brep {
 }
 
 impl Brep {
+    /// The B-rep without the faces `remove` (indices into [`Brep::faces`]): the others
+    /// keep their order, the shells their remaining faces; edges and vertices stay (an edge
+    /// that only a removed face used is used by none: not part of any hole). Where a face is
+    /// removed its edges become free — the hole a deleted face leaves.
+    pub fn without_faces(&self, remove: &[usize]) -> Brep {
+        let mut index = vec![None; self.faces.len()];
+        let mut faces = Vec::with_capacity(self.faces.len());
+        for (i, f) in self.faces.iter().enumerate() {
+            if !remove.contains(&i) {
+                index[i] = Some(faces.len());
+                faces.push(f.clone());
+            }
+        }
+        let shells = self
+            .shells
+            .iter()
+            .map(|s| BrepShell {
+                faces: s.faces.iter().filter_map(|&f| index.get(f).copied().flatten()).collect(),
+                ..s.clone()
+            })
+            .collect();
+        Brep { faces, edges: self.edges.clone(), vertices: self.vertices.clone(), shells }
+    }
+
     /// How the faces' loops run the edge `edge` (index into [`Brep::edges`]): one use per
     /// loop that names it, in the order of the faces.
     pub fn uses_of(&self, edge: usize) -> Vec<HoleUse> {
@@ -306,6 +330,21 @@ mod tests {
             },
         ];
         Brep { faces, edges, vertices, shells: vec![BrepShell { id: 30, closed: false, faces: vec![0, 1] }] }
+    }
+
+    /// Removing the bottom disc leaves two holes, the rims (the top one and the bottom
+    /// one the disc bounded); the shell keeps the wall, renumbered.
+    #[test]
+    fn a_removed_face_leaves_its_loop_as_a_hole() {
+        let b = open_cylinder(true).without_faces(&[1]);
+        assert_eq!(b.faces.len(), 1);
+        assert_eq!(b.faces[0].id, 20);
+        assert_eq!(b.shells[0].faces, vec![0]);
+        let mut edges: Vec<u64> = holes(&b).iter().map(|h| b.edges[h.uses[0].edge].id).collect();
+        edges.sort();
+        assert_eq!(edges, vec![10, 11]);
+        let b = open_cylinder(true).without_faces(&[0]);
+        assert_eq!((b.faces[0].id, b.shells[0].faces.clone()), (21, vec![0]));
     }
 
     /// The free boundary is the top rim; filled at order 4 and 6 the fill meets the

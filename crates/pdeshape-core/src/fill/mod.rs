@@ -825,6 +825,21 @@ impl Fill {
     /// `u` or in `v`. A surface that curves round (a fill wrapping a wing's nose) keeps its
     /// orientation from point to point, so only a real fold is counted.
     pub fn folds(&self, nu: usize, nv: usize) -> usize {
+        self.turns(nu, nv, 0.0)
+    }
+
+    /// Turn-overs: as [`folds`](Self::folds), but a normal counts as turned over only past
+    /// 120° from its neighbour's (cosine below −½). At a corner of the loop where the faces
+    /// around meet at a right angle (not G1) the normal turns by that angle from one side
+    /// of the corner to the other — `folds` counts it, this does not — while a cap folded
+    /// onto itself reverses its normal (cosine near −1).
+    pub fn turn_overs(&self, nu: usize, nv: usize) -> usize {
+        self.turns(nu, nv, -0.5)
+    }
+
+    /// Grid points whose normal vanishes, is not finite, or makes a cosine of at most
+    /// `min_cos` with a neighbour's (next in `u` or in `v`).
+    fn turns(&self, nu: usize, nv: usize, min_cos: f64) -> usize {
         let us: Vec<f64> = (0..nu).map(|i| 0.98 * i as f64 / (nu - 1) as f64).collect();
         let vs: Vec<f64> = (0..nv).map(|j| TAU * (j as f64 + 0.5) / nv as f64).collect();
         let g = self.patch.grid(&us, &vs);
@@ -837,10 +852,13 @@ impl Fill {
         for i in 0..nu {
             for j in 0..nv {
                 let n = at(i, j);
-                // not positive, NaN included
-                let against = |x: f64| x.is_nan() || x <= 0.0;
-                let flips = (i + 1 < nu && against(n.dot(at(i + 1, j)))) || against(n.dot(at(i, j + 1)));
-                if flips || against(n.norm() - tiny) {
+                // the cosine at most min_cos, NaN included
+                let against = |m: Vec3| {
+                    let c = n.dot(m) / (n.norm() * m.norm());
+                    c.is_nan() || c <= min_cos
+                };
+                let flips = (i + 1 < nu && against(at(i + 1, j))) || against(at(i, j + 1));
+                if flips || n.norm().is_nan() || n.norm() <= tiny {
                     folds += 1;
                 }
             }

@@ -255,12 +255,17 @@ fn set_pole_data_are_met() {
 }
 
 /// A ring turned inside out (negative length) turns the parametrisation over between the
-/// loop and the pole: the fold count sees it.
+/// loop and the pole: the fold count sees it, and so does the stricter turn-over count
+/// (the normal reverses); the same fill with its ring the right way round has neither.
 #[test]
 fn an_inverted_ring_is_a_fold() {
     let o = FillOptions { pole: Some(Vec3::new(0.0, 0.0, 1.0)), ring: Some(-0.4), ..Default::default() };
     let fill = Fill::new(&sphere_hole(5, 0.7), &o).unwrap();
     assert!(fill.folds(41, 200) > 0);
+    assert!(fill.turn_overs(41, 200) > 0);
+    let o = FillOptions { ring: Some(0.4), ..o };
+    let fill = Fill::new(&sphere_hole(5, 0.7), &o).unwrap();
+    assert_eq!((fill.folds(41, 200), fill.turn_overs(41, 200)), (0, 0));
 }
 
 /// The ring's fast derivatives equal its jets: `ρ (e₁ cos(v + kπ/2) + e₂ sin(v + kπ/2))`.

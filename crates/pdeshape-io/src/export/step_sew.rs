@@ -10,6 +10,10 @@
 //! `EDGE_CURVE`s — not copies — run against the direction their faces run them, so each
 //! joins its old face and the new one and the shell stays consistently oriented.
 //!
+//! Faces removed from the model (`StepModel::removed`, faces replaced by fills) leave their
+//! shells' face lists (their entities stay in the file, unreferenced); a shell the file
+//! calls closed must then have every hole filled.
+//!
 //! A shell whose holes are all filled becomes a `CLOSED_SHELL`; when it was the only shell
 //! of a `SHELL_BASED_SURFACE_MODEL` in a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION`, the
 //! model becomes a `MANIFOLD_SOLID_BREP` in an `ADVANCED_BREP_SHAPE_REPRESENTATION` (the
@@ -108,17 +112,41 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
         Ok((s, t, body.to_string()))
     };
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    // shells that lost faces and gain none
+    for sh in &b.shells {
+        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(&sh.id)));
+        if lost && !added.iter().any(|a| a.0 == sh.id) {
+            added.push((sh.id, Vec::new(), false));
+        }
+    }
     for (shell, new, closes) in &added {
         let (s, t, mut body) = text(*shell)?;
-        // `#N = OPEN_SHELL('name',(#a,#b));`: the new faces before the list's `)`
+        let closed_in_file = m.types.get(shell).map(String::as_str) == Some("CLOSED_SHELL");
+        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(shell)));
+        if lost && closed_in_file && !*closes {
+            return Err(format!(
+                "#{shell} CLOSED_SHELL: faces of it were removed, and not every hole they leave is filled (the shell would be open)"
+            ));
+        }
+        // `#N = OPEN_SHELL('name',(#a,#b));`: the removed faces out of the list, the new
+        // ones before its `)`
         let close = body.rfind(')').ok_or(format!("#{shell}: no closing parenthesis"))?;
         let list_end = body[..close].trim_end();
         if !list_end.ends_with(')') {
             return Err(format!("#{shell}: its face list is not the last attribute"));
         }
         let at = list_end.len() - 1;
-        let ids: String = new.iter().map(|i| format!(",#{i}")).collect();
-        body.insert_str(at, &ids);
+        let open = body[..at].rfind('(').ok_or(format!("#{shell}: its face list has no `(`"))?;
+        let kept: Vec<String> = body[open + 1..at]
+            .split(',')
+            .map(|x| x.trim().to_string())
+            .filter(|x| !x.is_empty() && !m.removed.iter().any(|id| *x == format!("#{id}")))
+            .chain(new.iter().map(|i| format!("#{i}")))
+            .collect();
+        if kept.is_empty() {
+            return Err(format!("#{shell}: every face of the shell was removed"));
+        }
+        body.replace_range(open + 1..at, &kept.join(","));
         let mut solid = None;
         if *closes && m.types.get(shell).map(String::as_str) == Some("OPEN_SHELL") {
             body = body.replacen("OPEN_SHELL", "CLOSED_SHELL", 1);

@@ -51,6 +51,34 @@ pub struct StepModel {
     pub users: HashMap<u64, Vec<u64>>,
     /// The largest `#id` in the file.
     pub max_id: u64,
+    /// Faces taken out of the model ([`StepModel::without_faces`]), by `#id`: left out of
+    /// their shells' face lists when the model is written back.
+    pub removed: Vec<u64>,
+}
+
+impl StepModel {
+    /// The model without the faces `ids` (`#id`s of faces of its shells, as `holes` names
+    /// them): their loops become holes — a face to be replaced by a fill. An id that is not
+    /// a face of the model is an error naming it.
+    pub fn without_faces(mut self, ids: &[u64]) -> Result<StepModel, StepError> {
+        let mut at = Vec::with_capacity(ids.len());
+        for &id in ids {
+            let Some(i) = self.brep.faces.iter().position(|f| f.id == id) else {
+                let what = self.types.get(&id).map_or("no entity of the file".to_string(), |t| format!("a {t}"));
+                return Err(StepError {
+                    file: self.file.clone(),
+                    line: self.spans.get(&id).map(|s| s.2),
+                    message: format!("#{id} is {what}, not a face of the model's shells"),
+                });
+            };
+            if !at.contains(&i) {
+                at.push(i);
+                self.removed.push(id);
+            }
+        }
+        self.brep = self.brep.without_faces(&at);
+        Ok(self)
+    }
 }
 
 /// A STEP file that cannot be read, with its place.
@@ -176,6 +204,7 @@ pub fn parse_step(source: Vec<u8>, file: &str, limits: &Limits) -> Result<StepMo
         types,
         users,
         max_id,
+        removed: Vec::new(),
     })
 }
 

@@ -13,7 +13,9 @@ across the new edges equal to 1e-6 relative.
 """
 
 import importlib.util
+import json
 import math
+import re
 import subprocess
 from pathlib import Path
 
@@ -199,3 +201,38 @@ def test_scene_importing_the_box_closes_it(models, tmp_path):
     # the bounds of fill-holes on this model (its size ~3.5)
     assert gap < 1e-9 * size(before), gap
     assert angle < 1e-8, angle
+
+
+def test_a_replaced_face_is_filled(models, tmp_path):
+    """`--replace-faces`: the cylinder's bottom disc taken out and both rims filled at
+    order 6: one valid solid of the unchanged wall and two new faces, no free edges,
+    within the bounds above across the new edges."""
+    src = models / "cylinder-open.step"
+    text = src.read_text()
+    hole = json.loads(subprocess.run([cli(), "holes", str(src), "--json"], capture_output=True, check=True).stdout)
+    wall = hole["holes"][0]["faces"][0]
+    ids = re.findall(r"^#(\d+)\s*=\s*ADVANCED_FACE", text, re.M)
+    (disc,) = [int(i) for i in ids if int(i) != wall]
+    out = tmp_path / "closed.step"
+    r = subprocess.run(
+        [cli(), "fill-holes", str(src), "-o", str(out), "--order", "6", "--replace-faces", str(disc)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    before, after = read(src), read(out)
+    assert BRepCheck_Analyzer(after).IsValid()
+    ex = TopExp_Explorer(after, TopAbs_SOLID)
+    assert ex.More()
+    ex.Next()
+    assert not ex.More()
+    assert [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)] == []
+    fb, fa = faces(before), faces(after)
+    assert len(fa) == 3
+    assert BRepAdaptor_Surface(fa[0]).GetType() == BRepAdaptor_Surface(fb[0]).GetType()
+    assert abs(area(fa[0]) - area(fb[0])) <= 1e-9 * area(fb[0])
+    gap, angle, _, krel = seams(after, fa[1:])
+    assert gap < 1e-9 * size(before), gap
+    assert angle < 1e-8, angle
+    assert krel < 1e-6, krel

@@ -21,9 +21,15 @@ class ModelError(Exception):
     """A model file (STEP or mesh) that cannot be read or whose holes cannot be filled;
     ``str(e)`` names the file, line and entity (or element)."""
 
-def holes(path: Union[str, PathLike[str]], *, limits: Optional[Dict[str, int]] = None) -> Dict[str, Any]:
+def holes(
+    path: Union[str, PathLike[str]],
+    *,
+    replace_faces: Optional[List[int]] = None,
+    limits: Optional[Dict[str, int]] = None,
+) -> Dict[str, Any]:
     """The holes of a STEP model or a triangle mesh (.obj, .ply, .stl): the dict
-    ``pdeshape holes MODEL --json`` prints."""
+    ``pdeshape holes MODEL --json`` prints; ``replace_faces`` (STEP) takes faces out first
+    by their ``#id``."""
     ...
 
 @overload
@@ -35,6 +41,7 @@ def fill_holes(
     holes: Optional[List[int]] = None,
     max_edges: Optional[int] = None,
     relative_tolerance: float = 1e-7,
+    replace_faces: Optional[List[int]] = None,
     limits: Optional[Dict[str, int]] = None,
     time_limit: Optional[float] = None,
 ) -> List[Dict[str, Any]]:
