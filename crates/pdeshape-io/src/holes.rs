@@ -248,6 +248,19 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
             .filter(|&i| o.max_edges.is_none_or(|n| holes[i].uses.len() <= n))
             .collect(),
     };
+    // a shell the file calls closed that lost faces must get every hole back filled:
+    // said before any fill is made
+    for (k, h) in holes.iter().enumerate() {
+        let shell = &m.brep.shells[m.brep.faces[h.uses[0].face].shell];
+        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(&shell.id)));
+        if lost && shell.closed && !chosen.contains(&k) {
+            return Err(format!(
+                "hole {} is not asked for, but faces of the closed shell #{} were replaced: every hole they leave must be filled",
+                k + 1,
+                shell.id
+            ));
+        }
+    }
     let mut out = Vec::with_capacity(chosen.len());
     for i in chosen {
         let opts = FillOptions { order: o.order, ..Default::default() };

@@ -401,8 +401,8 @@ fn a_scene_importing_a_model_builds_it_back_with_its_fills() {
 /// the surface model is a solid; every other entity is written back as it was. Replacing
 /// the two new faces of that closed result and filling one of the two holes they leave is
 /// refused (the closed shell would be open), as is a cap on the disc without its wall (it
-/// would fold); an id that is not a face is refused by name; a mesh has no faces to
-/// replace (usage).
+/// would fold); an id that is not a face, or a face with holes through it, is refused by
+/// name; a mesh has no faces to replace (usage).
 #[test]
 fn a_replaced_face_leaves_holes_that_are_filled() {
     let dir = tempfile::tempdir().unwrap();
@@ -446,7 +446,7 @@ fn a_replaced_face_leaves_holes_that_are_filled() {
     let o = run(&["fill-holes", o, "-o", h, "--replace-faces", &new_faces.join(","), "--holes", "1"]);
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("#16 CLOSED_SHELL") && err.contains("not every hole"), "{err}");
+    assert!(err.contains("hole 2 is not asked for") && err.contains("closed shell #16"), "{err}");
     assert!(!half.exists());
     // without its wall the disc's rim is the only loop, and the disc turns away from it
     // (outwards): a cap on it folds onto itself (OpenCASCADE read such a face as invalid,
@@ -459,6 +459,13 @@ fn a_replaced_face_leaves_holes_that_are_filled() {
     );
     assert!(!folded.exists());
     refused(&["holes", input.to_str().unwrap(), "--replace-faces", "31"], 1, &["#31 is a", "not a face"]);
+    // the tube with windows is one face of three loops: caps on each would overlap
+    let tube = model("tube-windows.step");
+    refused(
+        &["holes", tube.to_str().unwrap(), "--replace-faces", "17"],
+        1,
+        &["tube-windows.step:29: #17 ADVANCED_FACE has 3 loops"],
+    );
     refused(&["holes", input.to_str().unwrap(), "--replace-faces", "99999"], 1, &["#99999 is no entity"]);
     let mesh = dir.path().join("m.obj");
     std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();

@@ -59,7 +59,8 @@ pub struct StepModel {
 impl StepModel {
     /// The model without the faces `ids` (`#id`s of faces of its shells, as `holes` names
     /// them): their loops become holes — a face to be replaced by a fill. An id that is not
-    /// a face of the model is an error naming it.
+    /// a face of the model, or a face of more than one loop (holes through it, each of
+    /// which would get a cap of its own over the others), is an error naming it.
     pub fn without_faces(mut self, ids: &[u64]) -> Result<StepModel, StepError> {
         let mut at = Vec::with_capacity(ids.len());
         for &id in ids {
@@ -71,6 +72,16 @@ impl StepModel {
                     message: format!("#{id} is {what}, not a face of the model's shells"),
                 });
             };
+            let loops = self.brep.faces[i].loops.len();
+            if loops > 1 {
+                return Err(StepError {
+                    file: self.file.clone(),
+                    line: self.spans.get(&id).map(|s| s.2),
+                    message: format!(
+                        "#{id} ADVANCED_FACE has {loops} loops (an outer bound and holes through it): a fill replaces a face of one loop (each loop would get its own cap, the caps overlapping)"
+                    ),
+                });
+            }
             if !at.contains(&i) {
                 at.push(i);
                 self.removed.push(id);
