@@ -252,7 +252,7 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
     // said before any fill is made
     for (k, h) in holes.iter().enumerate() {
         let shell = &m.brep.shells[m.brep.faces[h.uses[0].face].shell];
-        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(&shell.id)));
+        let lost = m.shell_lost_faces(shell.id);
         if lost && shell.closed && !chosen.contains(&k) {
             return Err(format!(
                 "hole {} is not asked for, but faces of the closed shell #{} were replaced: every hole they leave must be filled",

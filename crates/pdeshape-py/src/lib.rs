@@ -1018,24 +1018,11 @@ fn holes(
             return serde_json::to_value(pdeshape_io::mesh_holes::mesh_holes_report(&mf, &loops))
                 .map_err(|e| e.to_string());
         }
-        let m = read_without(&path, &replace, &limits)?;
+        let m = pdeshape_io::import::step::read_step_without(&path, &replace, &limits).map_err(|e| e.to_string())?;
         let hs = pdeshape_core::brep::holes(&m.brep);
         serde_json::to_value(pdeshape_io::holes::holes_report(&m, &hs)).map_err(|e| e.to_string())
     });
     to_python(py, &report.map_err(model_error)?)
-}
-
-/// The STEP model at `path` without the faces `replace` (by `#id`).
-fn read_without(
-    path: &std::path::Path,
-    replace: &[u64],
-    limits: &pdeshape_core::limits::Limits,
-) -> Result<pdeshape_io::import::step::StepModel, String> {
-    let m = pdeshape_io::import::step::read_step(path, limits).map_err(|e| e.to_string())?;
-    if replace.is_empty() {
-        return Ok(m);
-    }
-    m.without_faces(replace).map_err(|e| e.to_string())
 }
 
 /// `replace_faces` names faces of a STEP model: a mesh has none.
@@ -1112,7 +1099,7 @@ fn fill_holes(
             pdeshape_io::mesh_holes::write_trimesh(&out, &filled)?;
             return serde_json::to_value(&reports).map_err(|e| e.to_string());
         }
-        let m = read_without(&path, &replace, &limits)?;
+        let m = pdeshape_io::import::step::read_step_without(&path, &replace, &limits).map_err(|e| e.to_string())?;
         let hs = pdeshape_core::brep::holes(&m.brep);
         let filled = pdeshape_io::holes::fill_holes(&m, &hs, &o).map_err(|e| format!("{}: {e}", m.file))?;
         if filled.is_empty() {

@@ -8,7 +8,7 @@ use pdeshape_core::limits::Limits;
 use pdeshape_core::trimesh::{MeshLoop, boundary};
 use pdeshape_io::holes::{FillHolesOptions, FilledHole, fill_holes, holes_report, write_filled};
 use pdeshape_io::import::mesh::{MeshFile, MeshFormat, read_mesh};
-use pdeshape_io::import::step::{StepModel, read_step};
+use pdeshape_io::import::step::{StepModel, read_step_without};
 use pdeshape_io::mesh_holes::{fill_mesh_holes, mesh_holes_report, mesh_view, render_trimesh, write_trimesh};
 use std::path::Path;
 
@@ -20,11 +20,7 @@ fn is_step(p: &Path) -> bool {
 
 /// The STEP model at `path` without the faces `replace` (by `#id`).
 fn load(path: &Path, replace: &[u64], limits: &Limits) -> Result<StepModel> {
-    let m = read_step(path, limits)?;
-    if replace.is_empty() {
-        return Ok(m);
-    }
-    Ok(m.without_faces(replace)?)
+    Ok(read_step_without(path, replace, limits)?)
 }
 
 /// `--replace-faces` names faces of a STEP model: a mesh has none.

@@ -114,7 +114,7 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     // shells that lost faces and gain none
     for sh in &b.shells {
-        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(&sh.id)));
+        let lost = m.shell_lost_faces(sh.id);
         if lost && !added.iter().any(|a| a.0 == sh.id) {
             added.push((sh.id, Vec::new(), false));
         }
@@ -122,7 +122,7 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
     for (shell, new, closes) in &added {
         let (s, t, mut body) = text(*shell)?;
         let closed_in_file = m.types.get(shell).map(String::as_str) == Some("CLOSED_SHELL");
-        let lost = m.removed.iter().any(|id| m.users.get(id).is_some_and(|u| u.contains(shell)));
+        let lost = m.shell_lost_faces(*shell);
         if lost && closed_in_file && !*closes {
             return Err(format!(
                 "#{shell} CLOSED_SHELL: faces of it were removed, and not every hole they leave is filled (the shell would be open)"

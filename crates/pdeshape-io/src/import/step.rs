@@ -57,6 +57,11 @@ pub struct StepModel {
 }
 
 impl StepModel {
+    /// Whether faces of the shell `#shell` were taken out ([`StepModel::without_faces`]).
+    pub fn shell_lost_faces(&self, shell: u64) -> bool {
+        self.removed.iter().any(|id| self.users.get(id).is_some_and(|u| u.contains(&shell)))
+    }
+
     /// The model without the faces `ids` (`#id`s of faces of its shells, as `holes` names
     /// them): their loops become holes — a face to be replaced by a fill. An id that is not
     /// a face of the model, or a face of more than one loop (holes through it, each of
@@ -102,6 +107,12 @@ pub struct StepError {
     pub line: Option<u32>,
     /// What is wrong, naming the entity (`#id TYPE`).
     pub message: String,
+}
+
+/// [`read_step`] and then [`StepModel::without_faces`] (`replace` empty: the model as read).
+pub fn read_step_without(path: &Path, replace: &[u64], limits: &Limits) -> Result<StepModel, StepError> {
+    let m = read_step(path, limits)?;
+    if replace.is_empty() { Ok(m) } else { m.without_faces(replace) }
 }
 
 /// Reads the STEP file at `path` (at most the `model` cap of bytes and the `entities`
