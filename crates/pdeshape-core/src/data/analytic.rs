@@ -122,13 +122,33 @@ impl AnalyticSurface {
         match self.kind {
             AnalyticKind::Plane => [l.x, l.y],
             AnalyticKind::Cylinder { .. } => [uw(u), h],
-            // the foot on the generator `(r + v tan α, v)` of the point's half-plane
+            // the foot on the nearer of the two generators `(±(r + v tan α), v)` in the
+            // point's plane through the axis: the cone is double, and past the apex
+            // (`r + v tan α < 0`) the point's own half-plane holds the other nappe, whose
+            // angle is `u + π`
             AnalyticKind::Cone { r, alpha } => {
                 let (s, c) = alpha.sin_cos();
-                [uw(u), ((rho - r) * s / c + h) * c * c]
+                let t = s / c;
+                let foot = |x: f64| ((x - r) * t + h) * c * c;
+                if (rho - r - h * t).abs() <= (-rho - r - h * t).abs() {
+                    [uw(u), foot(rho)]
+                } else {
+                    [uw(u + std::f64::consts::PI), foot(-rho)]
+                }
             }
             AnalyticKind::Sphere { .. } => [uw(u), h.atan2(rho)],
-            AnalyticKind::Torus { major, .. } => [uw(u), vw(h.atan2(rho - major))],
+            // the nearer of the two tube circles in the point's plane through the axis:
+            // on a spindle torus (minor > major) the inner, lemon-shaped part (`major +
+            // minor cos v < 0`) lies in the half-plane of angle `u + π`
+            AnalyticKind::Torus { major, minor } => {
+                let own = ((rho - major).hypot(h) - minor).abs();
+                let opposite = ((rho + major).hypot(h) - minor).abs();
+                if own <= opposite {
+                    [uw(u), vw(h.atan2(rho - major))]
+                } else {
+                    [uw(u + std::f64::consts::PI), vw(h.atan2(-rho - major))]
+                }
+            }
         }
     }
 
@@ -278,6 +298,42 @@ mod tests {
                 assert!((j.derivative([1, 0, 0]) - su).norm() < 1e-14, "{kind:?} S_u");
                 assert!((j.derivative([0, 1, 0]) - sv).norm() < 1e-14, "{kind:?} S_v");
             }
+        }
+    }
+
+    /// A cone is double: past its apex (`r + v tan α < 0`, where files such as EUCLID's
+    /// put faces) the point lies in the half-plane of angle `u + π`, and its foot is on
+    /// that nappe, not at the apex.
+    #[test]
+    fn a_point_past_a_cone_apex_is_inverted_onto_its_own_nappe() {
+        let s =
+            AnalyticSurface { kind: AnalyticKind::Cone { r: 7.5, alpha: std::f64::consts::FRAC_PI_4 }, frame: frame() };
+        for (u, v) in [(0.3, -17.5), (2.0, -7.6), (-2.5, -30.0), (1.0, 4.0)] {
+            let p = s.eval(&[u, v]);
+            for near in [None, Some([u, v])] {
+                let back = s.invert(p, near);
+                // the same point back to round-off (coordinates ≤ 40)
+                assert!((s.eval(&back) - p).norm() < 1e-13, "{u} {v} {near:?}: {back:?}");
+                assert!((back[1] - v).abs() < 1e-13, "{u} {v}: {back:?}");
+            }
+        }
+    }
+
+    /// A spindle torus (minor radius above the major, as EUCLID writes a screw's domed
+    /// head): where `major + minor cos v < 0` the point lies in the half-plane of angle
+    /// `u + π`, and its foot is on that tube circle.
+    #[test]
+    fn a_point_on_a_spindle_torus_lemon_is_inverted_onto_it() {
+        let s = AnalyticSurface { kind: AnalyticKind::Torus { major: 8.25, minor: 54.87 }, frame: frame() };
+        for (u, v) in [(0.3, 1.75), (2.0, -1.9), (-2.5, 0.2), (1.0, 2.9)] {
+            let p = s.eval(&[u, v]);
+            for near in [None, Some([u, v])] {
+                let back = s.invert(p, near);
+                // the same point back to round-off (coordinates ≤ 70)
+                assert!((s.eval(&back) - p).norm() < 1e-12, "{u} {v} {near:?}: {back:?}");
+            }
+            let back = s.invert(p, Some([u, v]));
+            assert!((back[0] - u).abs() < 1e-13 && (back[1] - v).abs() < 1e-13, "{u} {v}: {back:?}");
         }
     }
 
