@@ -590,3 +590,27 @@ fn third_party_models_are_read_and_their_replaced_faces_filled() {
     );
     assert!(!folded.exists());
 }
+
+/// A hole along one of pdeshape's own fill faces: the open cylinder's top filled at order
+/// 6, then its wall and bottom taken out, so that the only hole is the fill's rim. The
+/// fill's B-spline face closes on itself in `v`, and the rim's foot crosses that seam:
+/// the face is evaluated periodically there (its bare formula extrapolates off the face,
+/// where the foot was not found before). The cap meets the dome within the bounds.
+#[test]
+fn a_hole_along_a_fill_face_crosses_its_seam() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = model("cylinder-open.step");
+    let dome = dir.path().join("dome.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", dome.to_str().unwrap(), "--order", "6"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.path().join("closed.step");
+    let (d, c) = (dome.to_str().unwrap(), out.to_str().unwrap());
+    let o = run(&["fill-holes", d, "-o", c, "--order", "6", "--replace-faces", "17,93"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let f = figures(&err);
+    assert_eq!(f.len(), 1, "{err}");
+    // the bounds of the issue (the model is ~3.8 across): measured 4.8e-11, 1.5e-9 rad
+    assert!(f[0].0 < 3.5e-9 && f[0].1 < 1e-8, "{err}");
+    assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
+}

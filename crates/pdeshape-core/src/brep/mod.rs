@@ -31,11 +31,20 @@ pub enum FaceSurface {
 }
 
 impl FaceSurface {
-    /// The surface as a field (slots `u`, `v`).
+    /// The surface as a field (slots `u`, `v`). A B-spline surface that closes on itself
+    /// in a direction (see [`wrap`](Self::wrap)) is evaluated periodically there: a
+    /// parameter past the knot range is moved back by the period first, so that a foot
+    /// walked along an edge across the face's seam stays on the face (the bare formula
+    /// extrapolates its end polynomials there, off the face). The jets are those of the
+    /// point in the domain, exact; across a seam where the surface is only C0 they are
+    /// the side the period lands on.
     pub fn field(&self) -> FieldRef {
         match self {
             FaceSurface::Analytic(a) => Arc::new(*a),
-            FaceSurface::Nurbs(n) => n.clone(),
+            FaceSurface::Nurbs(n) => {
+                let closed = self.closed();
+                if closed.iter().any(|&c| c) { Arc::new(Periodic { n: n.clone(), closed }) } else { n.clone() }
+            }
         }
     }
 
@@ -82,6 +91,14 @@ impl FaceSurface {
     /// surface's extent); unchanged otherwise.
     pub fn wrap(&self, c: [f64; 2]) -> [f64; 2] {
         let FaceSurface::Nurbs(n) = self else { return c };
+        wrap_into(n.domain(), self.closed(), c)
+    }
+
+    /// In which directions a B-spline surface closes on itself: its two ends' isolines
+    /// meet at three points to 1e-9 of the surface's extent (analytic surfaces: never,
+    /// their formulas are periodic already).
+    pub fn closed(&self) -> [bool; 2] {
+        let FaceSurface::Nurbs(n) = self else { return [false, false] };
         let ((u0, u1), (v0, v1)) = n.domain();
         let scale = crate::num::max_nan(
             (n.eval(&[u0, v0]) - n.eval(&[u1, v1])).norm(),
@@ -90,21 +107,54 @@ impl FaceSurface {
         // a NaN scale closes nothing
         let close =
             |a: [f64; 2], b: [f64; 2]| (n.eval(&a) - n.eval(&b)).norm() <= 1e-9 * crate::num::max_nan(scale, 1e-300);
-        let mut out = c;
         let fr = [0.1, 0.5, 0.9];
-        if fr.iter().all(|f| close([u0, v0 + f * (v1 - v0)], [u1, v0 + f * (v1 - v0)])) {
-            out[0] = u0 + (c[0] - u0).rem_euclid(u1 - u0);
-        }
-        if fr.iter().all(|f| close([u0 + f * (u1 - u0), v0], [u0 + f * (u1 - u0), v1])) {
-            out[1] = v0 + (c[1] - v0).rem_euclid(v1 - v0);
-        }
-        out
+        [
+            fr.iter().all(|f| close([u0, v0 + f * (v1 - v0)], [u1, v0 + f * (v1 - v0)])),
+            fr.iter().all(|f| close([u0 + f * (u1 - u0), v0], [u0 + f * (u1 - u0), v1])),
+        ]
     }
 
     /// The unit normal `S_u × S_v / |·|` at `(u, v)` (`None` where the surface is singular).
     pub fn normal(&self, c: [f64; 2]) -> Option<Vec3> {
         let j = self.field().jet(&[c[0], c[1], 0.0], JetShape::new(&[1, 1]));
         j.derivative([1, 0, 0]).cross(j.derivative([0, 1, 0])).normalized()
+    }
+}
+
+/// `c` moved by a period into `domain` in the `closed` directions.
+fn wrap_into(domain: ((f64, f64), (f64, f64)), closed: [bool; 2], c: [f64; 2]) -> [f64; 2] {
+    let ((u0, u1), (v0, v1)) = domain;
+    let mut out = c;
+    if closed[0] {
+        out[0] = u0 + (c[0] - u0).rem_euclid(u1 - u0);
+    }
+    if closed[1] {
+        out[1] = v0 + (c[1] - v0).rem_euclid(v1 - v0);
+    }
+    out
+}
+
+/// A B-spline surface evaluated periodically in the directions in which it closes.
+#[derive(Debug)]
+struct Periodic {
+    n: Arc<NurbsSurface>,
+    closed: [bool; 2],
+}
+
+impl Field for Periodic {
+    fn arity(&self) -> usize {
+        self.n.arity()
+    }
+
+    fn jet(&self, at: &[f64], shape: JetShape) -> crate::data::VecJet {
+        let c = wrap_into(self.n.domain(), self.closed, [at[0], at[1]]);
+        let mut moved = at.to_vec();
+        moved[..2].copy_from_slice(&c);
+        self.n.jet(&moved, shape)
+    }
+
+    fn is_constant_in(&self, slot: usize) -> bool {
+        self.n.is_constant_in(slot)
     }
 }
 
