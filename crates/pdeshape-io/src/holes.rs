@@ -7,7 +7,7 @@
 use crate::export::{SewnFace, sewn_step, write_atomic};
 use crate::import::step::StepModel;
 use pdeshape_core::Vec3;
-use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleKind, fill_hole};
+use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleKind, HoleUse, fill_hole};
 use pdeshape_core::fill::{Fill, FillOptions, foot_of};
 use pdeshape_core::fit::{BSplineSurface, EdgeTolerance, FitOptions, FitReport, fit_surface};
 use pdeshape_core::num::max_nan;
@@ -258,6 +258,18 @@ pub fn fill_holes(m: &StepModel, holes: &[Hole], o: &FillHolesOptions) -> Result
                 "hole {} is not asked for, but faces of the closed shell #{} were replaced: every hole they leave must be filled",
                 k + 1,
                 shell.id
+            ));
+        }
+    }
+    // a hole between parts of different shells: its face would join the shells, which
+    // the writer does not do (`export::step_sew`); said before any fill is made
+    for &k in &chosen {
+        let shell_id = |u: &HoleUse| m.brep.shells[m.brep.faces[u.face].shell].id;
+        let first = shell_id(&holes[k].uses[0]);
+        if let Some(other) = holes[k].uses.iter().map(shell_id).find(|&s| s != first) {
+            return Err(format!(
+                "hole {}: it runs along faces of the shells #{first} and #{other} (parts that touch): a new face joining two shells is not written",
+                k + 1
             ));
         }
     }

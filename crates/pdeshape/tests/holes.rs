@@ -614,3 +614,83 @@ fn a_hole_along_a_fill_face_crosses_its_seam() {
     assert!(f[0].0 < 3.5e-9 && f[0].1 < 1e-8, "{err}");
     assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
 }
+
+/// Two parts that touch at (0, ±1, 1), each with its own vertices there (written by
+/// OpenCASCADE as one shell): the gap between them is two holes, each along the lower
+/// part's wall and back along the upper part's. Filled at order 6, the model is closed:
+/// the upper part's edges now use the lower part's vertices at the touching points (so
+/// the new faces' loops are connected through shared vertices) and every other input
+/// entity is as it was.
+#[test]
+fn the_gap_between_touching_parts_is_filled() {
+    let input = model("touching-parts.step");
+    let j = json(&input);
+    let hs = j["holes"].as_array().unwrap();
+    assert_eq!(hs.len(), 2, "{j}");
+    for h in hs {
+        assert_eq!(h["kind"], "hole", "{h}");
+        // the lower wall (#17) and the upper one (#152)
+        assert_eq!(h["faces"].as_array().unwrap(), &vec![serde_json::json!(17), serde_json::json!(152)], "{h}");
+        // half of each rim (x > 0 or x < 0; the rims are the ellipses z = 1 ∓ |x|/2
+        // on the unit cylinder): ∫ √(1 + sin²θ / 4) dθ over [−π/2, π/2] = 2 E(m = −1/4)
+        // = 3.32958361078268 each (mpmath `ellipe`, 30 digits); the edge lengths are
+        // Gauss–Legendre sums, to ~1e-12 here
+        assert!((h["length"].as_f64().unwrap() - 2.0 * 3.329_583_610_782_676).abs() < 1e-9, "{h}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("closed.step");
+    let o = run(&["fill-holes", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--order", "6"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let f = figures(&err);
+    assert_eq!(f.len(), 2, "{err}");
+    for (gap, angle) in f {
+        // the bounds on a model 3.5 across
+        assert!(gap < 3.5e-9 && angle < 1e-8, "{err}");
+    }
+    let before = entities(&std::fs::read_to_string(&input).unwrap());
+    let after = entities(&std::fs::read_to_string(&out).unwrap());
+    let changed: Vec<u64> = before.iter().filter(|(id, body)| after.get(id) != Some(body)).map(|(id, _)| *id).collect();
+    // the shell, its surface model and representation (now a solid), and the upper part's
+    // three edges at the touching points
+    assert_eq!(changed, vec![10, 15, 16, 214, 236, 264], "{err}");
+    assert_eq!(after[&214], "EDGE_CURVE('',#24,#157,#217,.T.)");
+    assert_eq!(after[&236], "EDGE_CURVE('',#102,#24,#239,.T.)");
+    assert_eq!(after[&264], "EDGE_CURVE('',#157,#102,#265,.T.)");
+    // the vertices the upper part gave up sit where the lower part's are
+    for (gone, kept) in [(215, 24), (237, 102)] {
+        let point = |v: u64| {
+            let p = after[&v].split('#').nth(1).unwrap().trim_end_matches(')').parse::<u64>().unwrap();
+            after[&p].clone()
+        };
+        let coords = |s: String| -> Vec<f64> {
+            s.split(['(', ')']).nth(2).unwrap().split(',').map(|x| x.trim().parse().unwrap()).collect()
+        };
+        let (a, b) = (coords(point(gone)), coords(point(kept)));
+        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12), "{a:?} {b:?}");
+    }
+    assert_eq!(json(&out)["holes"].as_array().unwrap().len(), 0);
+    // the same parts as two shells of one surface model: the holes run across both, and
+    // a face joining two shells is refused before any fill is made, nothing written
+    let text = std::fs::read_to_string(&input).unwrap();
+    let two = text
+        .replacen("SHELL_BASED_SURFACE_MODEL('',(#16));", "SHELL_BASED_SURFACE_MODEL('',(#16,#99999));", 1)
+        .replacen(
+            "#16 = OPEN_SHELL('',(#17,#148,#152,#283));",
+            "#16 = OPEN_SHELL('',(#17,#148));\n#99999 = OPEN_SHELL('',(#152,#283));",
+            1,
+        );
+    assert_eq!(two.matches("#99999").count(), 2);
+    let split = dir.path().join("split.step");
+    std::fs::write(&split, two).unwrap();
+    let j = json(&split);
+    assert_eq!(j["shells"], 2, "{j}");
+    assert_eq!(j["holes"].as_array().unwrap().len(), 2, "{j}");
+    let refused_out = dir.path().join("refused.step");
+    refused(
+        &["fill-holes", split.to_str().unwrap(), "-o", refused_out.to_str().unwrap()],
+        1,
+        &["split.step: hole 1: it runs along faces of the shells #16 and #99999", "not written"],
+    );
+    assert!(!refused_out.exists());
+}

@@ -4,10 +4,20 @@
 //! In a consistently oriented shell every loop has its face on the left, so along the
 //! free boundary the uses of the free edges follow each other head to tail: a hole is a
 //! cycle of such uses, run the way its faces run them.
+//!
+//! **Parts that touch.** Where two parts of a model touch at a point, each has its own
+//! vertex there (different entities at the same place), and the gap between them is a
+//! loop that runs along one part's edges and back along the other's. Vertices within
+//! 1e-7 of the model's size of each other are one point for the chaining; where more than
+//! one free edge leaves such a point, the loop takes the sharpest turn to the right (seen
+//! from the face's normal, the side where the hole is, the face being on the left), which
+//! closes the smallest loop around the gap. Two free edges leaving the same vertex entity
+//! remain a loop that touches itself.
 
 use super::{Brep, FaceSurface};
 use crate::Vec3;
 use crate::fill::foot_of;
+use crate::jet::JetShape;
 use crate::num::{max_nan, min_nan};
 
 /// One edge of a hole, as the face around it uses it.
@@ -78,6 +88,47 @@ fn oriented_normal(s: Option<&FaceSurface>, same_sense: bool, p: Vec3) -> Option
     Some(if same_sense { n } else { -n })
 }
 
+/// For each vertex, the smallest index of the vertices within `tol` of it (transitively):
+/// one point where parts touch.
+fn touching(b: &Brep, tol: f64) -> Vec<usize> {
+    let n = b.vertices.len();
+    let mut rep: Vec<usize> = (0..n).collect();
+    fn root(rep: &mut [usize], mut i: usize) -> usize {
+        while rep[i] != i {
+            rep[i] = rep[rep[i]];
+            i = rep[i];
+        }
+        i
+    }
+    // sorted by x, pairs closer than `tol` in x are compared (NaN points stay alone)
+    let mut order: Vec<usize> = (0..n).filter(|&i| b.vertices[i].1.x.is_finite()).collect();
+    order.sort_by(|&i, &j| b.vertices[i].1.x.total_cmp(&b.vertices[j].1.x));
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if b.vertices[j].1.x - b.vertices[i].1.x > tol {
+                break;
+            }
+            if (b.vertices[j].1 - b.vertices[i].1).norm() <= tol {
+                let (ri, rj) = (root(&mut rep, i), root(&mut rep, j));
+                rep[ri.max(rj)] = ri.min(rj);
+            }
+        }
+    }
+    (0..n).map(|i| root(&mut rep, i)).collect()
+}
+
+/// The unit tangent of `u` at its start (`end = false`) or end, in the direction the face
+/// runs it (NaN without a curve).
+fn tangent(b: &Brep, u: &HoleUse, end: bool) -> Vec3 {
+    let e = &b.edges[u.edge];
+    let Some(c) = &e.curve else { return Vec3::new(f64::NAN, f64::NAN, f64::NAN) };
+    let (a, z) = if u.forward { e.range } else { (e.range.1, e.range.0) };
+    let tau = if end { z } else { a };
+    let d = c.field().jet(&[tau], JetShape::new(&[1])).derivative([1, 0, 0]);
+    let d = if (z - a) >= 0.0 { d } else { -d };
+    d.normalized().unwrap_or(Vec3::new(f64::NAN, f64::NAN, f64::NAN))
+}
+
 /// The free boundary of `b` as loops, in the order of their first edge in the file.
 pub fn holes(b: &Brep) -> Vec<Hole> {
     let mut count = vec![0usize; b.edges.len()];
@@ -95,6 +146,19 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
         let v = b.edges[u.edge].vertices;
         if u.forward { (v[0], v[1]) } else { (v[1], v[0]) }
     };
+    // the model's size: the diagonal of its vertices' box
+    let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    for (_, p) in &b.vertices {
+        lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
+        hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
+    }
+    let size = if b.vertices.is_empty() { 0.0 } else { (hi - lo).norm() };
+    let rep = touching(b, 1e-7 * size);
+    let at_rep = |u: &HoleUse| {
+        let (s, e) = ends(u);
+        (rep[s], rep[e])
+    };
     let mut taken = vec![false; free.len()];
     let mut out = Vec::new();
     for first in 0..free.len() {
@@ -103,26 +167,51 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
         }
         taken[first] = true;
         let mut uses = vec![free[first]];
-        let start = ends(&free[first]).0;
-        let mut at = ends(&free[first]).1;
+        let start = at_rep(&free[first]).0;
+        let mut at = at_rep(&free[first]).1;
         let mut kind = HoleKind::Simple;
         while at != start {
-            let next: Vec<usize> = (0..free.len()).filter(|&k| !taken[k] && ends(&free[k]).0 == at).collect();
-            let Some(&k) = next.first() else {
+            let next: Vec<usize> = (0..free.len()).filter(|&k| !taken[k] && at_rep(&free[k]).0 == at).collect();
+            let last = *uses.last().expect("a loop has its first use");
+            // two free uses leaving the vertex entity this one ends at: the loop
+            // touches itself there
+            if next.iter().filter(|&&k| ends(&free[k]).0 == ends(&last).1).count() > 1 {
+                kind = HoleKind::TouchesItself;
+            }
+            let k = if next.len() > 1 {
+                // where parts touch: the sharpest turn to the right, about the normal of
+                // the face arriving (NaN turns last)
+                let p = b.vertices[ends(&last).1].1;
+                let f = &b.faces[last.face];
+                let n = oriented_normal(f.surface.as_ref(), f.same_sense, p);
+                let t_in = tangent(b, &last, true);
+                let turn = |k: usize| {
+                    let t = tangent(b, &free[k], false);
+                    let a = n.map_or(f64::NAN, |n| n.dot(t_in.cross(t)).atan2(t_in.dot(t)));
+                    if a.is_nan() { f64::INFINITY } else { a }
+                };
+                next.iter().copied().min_by(|&i, &j| turn(i).total_cmp(&turn(j)))
+            } else {
+                next.first().copied()
+            };
+            let Some(k) = k else {
                 kind = HoleKind::Open;
                 break;
             };
-            if next.len() > 1 {
-                kind = HoleKind::TouchesItself;
-            }
             taken[k] = true;
             uses.push(free[k]);
-            at = ends(&free[k]).1;
+            at = at_rep(&free[k]).1;
         }
-        // a vertex left by two free edges: the loop touches itself there
+        // a vertex entity left by two free edges: the loop touches itself there
         if kind == HoleKind::Simple
             && (0..free.len()).any(|k| !uses.contains(&free[k]) && uses.iter().any(|u| ends(u).0 == ends(&free[k]).0))
         {
+            kind = HoleKind::TouchesItself;
+        }
+        // a point passed twice
+        let mut passed: Vec<usize> = uses.iter().map(|u| at_rep(u).0).collect();
+        passed.sort_unstable();
+        if kind == HoleKind::Simple && passed.windows(2).any(|w| w[0] == w[1]) {
             kind = HoleKind::TouchesItself;
         }
         let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);

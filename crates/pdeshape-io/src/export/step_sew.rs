@@ -14,6 +14,11 @@
 //! shells' face lists (their entities stay in the file, unreferenced); a shell the file
 //! calls closed must then have every hole filled.
 //!
+//! Where a hole runs from one part to another that touches it (two vertex entities at one
+//! point, see `brep::holes`), the edges at the second vertex are rewritten to use the
+//! first, so the new face's loop runs through shared vertices; a hole along faces of two
+//! shells is refused.
+//!
 //! A shell whose holes are all filled becomes a `CLOSED_SHELL`; when it was the only shell
 //! of a `SHELL_BASED_SURFACE_MODEL` in a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION`, the
 //! model becomes a `MANIFOLD_SOLID_BREP` in an `ADVANCED_BREP_SHAPE_REPRESENTATION` (the
@@ -41,6 +46,32 @@ pub struct SewnFace<'a> {
 pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>, String> {
     let b = &m.brep;
     let mut e = Entities { text: String::new(), next: m.max_id as usize };
+    let start_of = |u: &pdeshape_core::brep::HoleUse| {
+        let v = b.edges[u.edge].vertices;
+        if u.forward { v[0] } else { v[1] }
+    };
+    let end_of = |u: &pdeshape_core::brep::HoleUse| {
+        let v = b.edges[u.edge].vertices;
+        if u.forward { v[1] } else { v[0] }
+    };
+    // where a hole passes from one part to another that touches it (two vertex entities
+    // at one point, `brep::holes`), the vertices become one — the smallest index of each
+    // such class — so that each new face's loop runs through shared vertices
+    let mut same: Vec<usize> = (0..b.vertices.len()).collect();
+    let root = |same: &mut Vec<usize>, mut i: usize| {
+        while same[i] != i {
+            i = same[i];
+        }
+        i
+    };
+    for f in faces {
+        let uses = &f.hole.uses;
+        for k in 0..uses.len() {
+            let (a, c) = (root(&mut same, end_of(&uses[k])), root(&mut same, start_of(&uses[(k + 1) % uses.len()])));
+            same[a.max(c)] = a.min(c);
+        }
+    }
+    let same: Vec<usize> = (0..same.len()).map(|i| root(&mut same, i)).collect();
     // (shell id, new face ids)
     let mut added: Vec<(u64, Vec<usize>, bool)> = Vec::new();
     for f in faces {
@@ -55,10 +86,6 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
         let start = s.control[0];
         // the hole's vertex where the face's v = 0 starts
         let n = f.hole.uses.len();
-        let start_of = |u: &pdeshape_core::brep::HoleUse| {
-            let v = b.edges[u.edge].vertices;
-            if u.forward { v[0] } else { v[1] }
-        };
         let (k0, d) = (0..n)
             .map(|k| (k, (b.vertices[start_of(&f.hole.uses[k])].1 - start).norm()))
             .min_by(|a, c| a.1.total_cmp(&c.1))
@@ -68,7 +95,7 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
                 "the new face starts {d:.3e} from the nearest vertex of its hole (the tolerance is {tol:.3e})"
             ));
         }
-        let v0 = b.vertices[start_of(&f.hole.uses[k0])].0;
+        let v0 = b.vertices[same[start_of(&f.hole.uses[k0])]].0;
         let srf = e.surface(s);
         // the pole: the u = 1 row, one point
         let pole_row: Vec<Vec3> = (0..nv).map(|j| s.control[(nu - 1) * nv + j]).collect();
@@ -96,6 +123,13 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
         let bound = e.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"));
         let face = e.add(&format!("ADVANCED_FACE('',(#{bound}),#{srf},.T.)"));
         let shell = b.shells[b.faces[f.hole.uses[0].face].shell].id;
+        // parts that touch in different shells: the new face would join them, and the
+        // shells' structure (one surface model, or separate parts) is the file's to say
+        if let Some(other) = f.hole.uses.iter().map(|u| b.shells[b.faces[u.face].shell].id).find(|&id| id != shell) {
+            return Err(format!(
+                "a hole runs along faces of the shells #{shell} and #{other}: a new face joining two shells is not written"
+            ));
+        }
         match added.iter_mut().find(|a| a.0 == shell) {
             Some(a) => {
                 a.1.push(face);
@@ -112,6 +146,21 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
         Ok((s, t, body.to_string()))
     };
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    // the edges at a merged vertex: `EDGE_CURVE('name',#start,#end,#curve,sense)` with
+    // the vertex replaced
+    for edge in &b.edges {
+        let [s0, s1] = edge.vertices;
+        if same[s0] == s0 && same[s1] == s1 {
+            continue;
+        }
+        let (s, t, body) = text(edge.id)?;
+        let (start, end) = (b.vertices[same[s0]].0, b.vertices[same[s1]].0);
+        edits.push((
+            s,
+            t,
+            edge_with_vertices(&body, start, end).ok_or(format!("#{}: not an EDGE_CURVE as read", edge.id))?,
+        ));
+    }
     // shells that lost faces and gain none
     for sh in &b.shells {
         let lost = m.shell_lost_faces(sh.id);
@@ -192,4 +241,34 @@ pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>,
         out.splice(s..t, body.into_bytes());
     }
     Ok(out)
+}
+
+/// `#N = EDGE_CURVE('name', #a, #b, #curve, sense);` with `#start` and `#end` for `#a`
+/// and `#b` (`None` when the text is not of that form).
+fn edge_with_vertices(body: &str, start: u64, end: u64) -> Option<String> {
+    let open = body.find("EDGE_CURVE")? + "EDGE_CURVE".len();
+    let rest = body[open..].trim_start().strip_prefix('(')?;
+    // the name: a string whose quotes are doubled inside it
+    let rest_t = rest.trim_start();
+    let mut i = body.len() - rest_t.len();
+    if !rest_t.starts_with('\'') {
+        return None;
+    }
+    i += 1;
+    let bytes = body.as_bytes();
+    loop {
+        match bytes.get(i)? {
+            b'\'' if bytes.get(i + 1) == Some(&b'\'') => i += 2,
+            b'\'' => break,
+            _ => i += 1,
+        }
+    }
+    let after_name = i + 1;
+    // the two vertex references: `, #a , #b ,`
+    let mut parts = body[after_name..].splitn(4, ',');
+    let (lead, a, bb, tail) = (parts.next()?, parts.next()?, parts.next()?, parts.next()?);
+    if !lead.trim().is_empty() || !a.trim().starts_with('#') || !bb.trim().starts_with('#') {
+        return None;
+    }
+    Some(format!("{},#{start},#{end},{tail}", &body[..after_name]))
 }

@@ -5,7 +5,8 @@ OpenCASCADE builds each model in the test (`make_models.py` beside the committed
 crates/pdeshape/tests/data/step): a cylinder without its top (one closed edge), a box
 with rounded edges without its eight spherical corners (three-sided holes between
 cylinders), a B-spline loft without its top, a B-spline tube with two windows cut through
-its wall (its two ends and the windows: four holes on one face). `fill-holes` at order 4 and 6; OCCT reads the
+its wall (its two ends and the windows: four holes on one face), two parts that touch at
+two points with a gap between them (two holes, each along both parts' edges). `fill-holes` at order 4 and 6; OCCT reads the
 result and must find one valid solid, no free edges, every input face unchanged (its
 surface type and area), and along every edge of a new face a gap of at most 1e-9 of the
 model's size and a normal angle of at most 1e-8 rad; at order 6 the normal curvature
@@ -50,7 +51,7 @@ make_models = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(make_models)
 
 # name: number of holes
-MODELS = {"cylinder-open": 1, "rounded-box-corners": 8, "loft-open": 1, "tube-windows": 4}
+MODELS = {"cylinder-open": 1, "rounded-box-corners": 8, "loft-open": 1, "tube-windows": 4, "touching-parts": 2}
 
 
 @pytest.fixture(scope="module")

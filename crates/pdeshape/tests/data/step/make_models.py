@@ -13,23 +13,34 @@
   smaller circle) with two windows cut through its wall by boxes: four holes on its one
   face — the two open ends (one closed edge each) and the two windows (four edges each,
   where the boxes cut the wall).
+- touching-parts.step: two parts of one open shell that touch at two points, with a gap
+  between them: the lower part a cylinder (radius 1) with its bottom, cut by a roof
+  z = 1 − |x|/2, the upper part the same cylinder with its top, cut by z = 1 + |x|/2;
+  the roofs left out. They touch at (0, ±1, 1), each with its own vertices there; the gap
+  is two lens-shaped holes, each running along the lower part's edges and back along the
+  upper part's.
 
 Made by this project with OpenCASCADE; no third-party content.
 """
 
-from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Surface
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakePolygon,
+    BRepBuilderAPI_MakeWire,
+)
 from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
 from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
-from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GeomAbs import GeomAbs_Plane, GeomAbs_Sphere
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shell
-from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Elips, gp_Pnt
+from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Elips, gp_Pnt, gp_Vec
 
 
 def faces(shape):
@@ -96,6 +107,31 @@ def main():
     for lo, hi in [((-0.35, 0.2, 0.8), (0.35, 2.0, 1.6)), ((-0.3, -2.0, 1.7), (0.3, -0.2, 2.3))]:
         cut = BRepAlgoAPI_Cut(cut, BRepPrimAPI_MakeBox(gp_Pnt(*lo), gp_Pnt(*hi)).Shape()).Shape()
     write(cut, "tube-windows.step")
+
+    def prism(xz):
+        """The polygon `xz` in the plane y = -2, swept to y = 2."""
+        poly = BRepBuilderAPI_MakePolygon()
+        for x, z in xz:
+            poly.Add(gp_Pnt(x, -2.0, z))
+        poly.Close()
+        return BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), gp_Vec(0, 4.0, 0)).Shape()
+
+    cyl = BRepPrimAPI_MakeCylinder(1.0, 2.0).Shape()
+    lower = BRepAlgoAPI_Common(cyl, prism([(-2, -1), (2, -1), (2, 0), (0, 1), (-2, 0)])).Shape()
+    upper = BRepAlgoAPI_Common(cyl, prism([(-2, 2), (0, 1), (2, 2), (2, 3), (-2, 3)])).Shape()
+
+    def roof(f):
+        s = BRepAdaptor_Surface(f)
+        return s.GetType() == GeomAbs_Plane and abs(abs(s.Plane().Axis().Direction().Z()) - 1) > 1e-9
+
+    b = BRep_Builder()
+    both = TopoDS_Shell()
+    b.MakeShell(both)
+    for part in (lower, upper):
+        for f in faces(part):
+            if not roof(f):
+                b.Add(both, f)
+    write(both, "touching-parts.step")
 
 
 if __name__ == "__main__":
