@@ -40,7 +40,13 @@ from brep_geometry import edge_uses, faces, jet, normal_curvature  # noqa: E402
 DATA = ROOT / "crates/pdeshape/tests/data/step"
 BIN = os.environ.get("PDESHAPE_BIN", str(ROOT / "target/release/pdeshape"))
 # model, the hole's number in `pdeshape holes`, a point of the hole's box (to pick OCCT's edges)
-CASES = [("cylinder-open", 1, (0, 0, 2)), ("rounded-box-corners", 1, (0, 0, 0)), ("loft-open", 1, (0, 0, 2))]
+CASES = [
+    ("cylinder-open", 1, (0, 0, 2)),
+    ("rounded-box-corners", 1, (0, 0, 0)),
+    ("loft-open", 1, (0, 0, 2)),
+    # the lens between the touching parts on the side x < 0 (one edge of each part)
+    ("touching-parts", 2, (-1, 0, 1)),
+]
 PER_EDGE = 200
 
 
@@ -93,7 +99,7 @@ def occt(edges, order):
         return None
     if not f.IsDone():
         return None
-    return next(faces(f.Shape()))
+    return faces(f.Shape())[0]
 
 
 def ours(model, k, order, out):

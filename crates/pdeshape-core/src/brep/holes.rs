@@ -93,6 +93,9 @@ fn oriented_normal(s: Option<&FaceSurface>, same_sense: bool, p: Vec3) -> Option
 fn touching(b: &Brep, tol: f64) -> Vec<usize> {
     let n = b.vertices.len();
     let mut rep: Vec<usize> = (0..n).collect();
+    if !tol.is_finite() {
+        return rep;
+    }
     fn root(rep: &mut [usize], mut i: usize) -> usize {
         while rep[i] != i {
             rep[i] = rep[rep[i]];
@@ -146,15 +149,8 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
         let v = b.edges[u.edge].vertices;
         if u.forward { (v[0], v[1]) } else { (v[1], v[0]) }
     };
-    // the model's size: the diagonal of its vertices' box
-    let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
-    let mut hi = -lo;
-    for (_, p) in &b.vertices {
-        lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
-        hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
-    }
-    let size = if b.vertices.is_empty() { 0.0 } else { (hi - lo).norm() };
-    let rep = touching(b, 1e-7 * size);
+    // (a NaN size merges nothing)
+    let rep = touching(b, 1e-7 * b.size());
     let at_rep = |u: &HoleUse| {
         let (s, e) = ends(u);
         (rep[s], rep[e])

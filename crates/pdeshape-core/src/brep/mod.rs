@@ -15,6 +15,7 @@ use crate::Vec3;
 use crate::data::analytic::{AnalyticCurve, AnalyticSurface};
 use crate::data::{Field, FieldRef, NurbsCurve, NurbsSurface};
 use crate::jet::JetShape;
+use crate::num::{max_nan, min_nan};
 use std::sync::Arc;
 
 pub use fill::{EdgePieces, HoleFill, HoleFillError, edge_pieces, fill_hole, fill_uses, pieces_per_edge};
@@ -311,8 +312,9 @@ impl Brep {
         let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let mut hi = -lo;
         let mut add = |p: Vec3| {
-            lo = Vec3::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z));
-            hi = Vec3::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z));
+            // NaN kept: a point that is not a number makes no size
+            lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
+            hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
         };
         for (_, p) in &self.vertices {
             add(*p);

@@ -81,6 +81,27 @@ def size(shape):
     return box.CornerMin().Distance(box.CornerMax())
 
 
+def solids(shape):
+    """The number of solids OCCT finds in `shape`."""
+    ex, n = TopExp_Explorer(shape, TopAbs_SOLID), 0
+    while ex.More():
+        n, _ = n + 1, ex.Next()
+    return n
+
+
+def fill_replacing(src, out, ids):
+    """`fill-holes SRC -o OUT --order 6 --replace-faces IDS`, which must succeed; the input
+    and the output as OCCT reads them."""
+    r = subprocess.run(
+        [cli(), "fill-holes", str(src), "-o", str(out), "--order", "6", "--replace-faces", ids],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    return read(src), read(out)
+
+
 class Projector:
     """Feet of points on one face's surface (within the face's parameter bounds), the
     projection set up once: a new `GeomAPI_ProjectPointOnSurf` per point samples the whole
@@ -153,12 +174,7 @@ def closed_with_new_faces(before, after, added):
     `before`'s, in their order and unchanged (type, area), followed by `added` new ones;
     the largest gap, normal angle and curvature difference across the new faces' edges."""
     assert BRepCheck_Analyzer(after).IsValid()
-    ex = TopExp_Explorer(after, TopAbs_SOLID)
-    solids = 0
-    while ex.More():
-        solids += 1
-        ex.Next()
-    assert solids == 1
+    assert solids(after) == 1
     free = [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)]
     assert free == []
     fb, fa = faces(before), faces(after)
@@ -219,20 +235,9 @@ def test_a_replaced_face_is_filled(models, tmp_path):
     wall = hole["holes"][0]["faces"][0]
     ids = re.findall(r"^#(\d+)\s*=\s*ADVANCED_FACE", text, re.M)
     (disc,) = [int(i) for i in ids if int(i) != wall]
-    out = tmp_path / "closed.step"
-    r = subprocess.run(
-        [cli(), "fill-holes", str(src), "-o", str(out), "--order", "6", "--replace-faces", str(disc)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert r.returncode == 0, r.stderr
-    before, after = read(src), read(out)
+    before, after = fill_replacing(src, tmp_path / "closed.step", str(disc))
     assert BRepCheck_Analyzer(after).IsValid()
-    ex = TopExp_Explorer(after, TopAbs_SOLID)
-    assert ex.More()
-    ex.Next()
-    assert not ex.More()
+    assert solids(after) == 1
     assert [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)] == []
     fb, fa = faces(before), faces(after)
     assert len(fa) == 3
@@ -267,23 +272,8 @@ def test_third_party_model(name, tmp_path):
     the new faces' edges within the issue's bounds. (AS1 is an assembly: OCCT places its
     parts' instances, so each face of the plate appears once per instance.)"""
     src = THIRD_PARTY / name
-    out = tmp_path / "filled.step"
-    r = subprocess.run(
-        [cli(), "fill-holes", str(src), "-o", str(out), "--order", "6", "--replace-faces", THIRD_PARTY_MODELS[name]],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert r.returncode == 0, r.stderr
-    before, after = read(src), read(out)
+    before, after = fill_replacing(src, tmp_path / "filled.step", THIRD_PARTY_MODELS[name])
     assert BRepCheck_Analyzer(after).IsValid()
-
-    def solids(shape):
-        ex, n = TopExp_Explorer(shape, TopAbs_SOLID), 0
-        while ex.More():
-            n, _ = n + 1, ex.Next()
-        return n
-
     assert solids(after) == solids(before) >= 1
     assert [e for e, fs in edge_uses(after) if len(fs) == 1 and not BRep_Tool.Degenerated_s(e)] == []
     fb, fa = faces(before), faces(after)
