@@ -7,7 +7,7 @@
 use crate::export::{SewnFace, sewn_step, write_atomic};
 use crate::import::step::StepModel;
 use pdeshape_core::Vec3;
-use pdeshape_core::brep::{Brep, FaceSurface, Hole, HoleKind, HoleUse, fill_hole};
+use pdeshape_core::brep::{Brep, Hole, HoleKind, HoleUse, fill_hole};
 use pdeshape_core::fill::{Fill, FillOptions, foot_of};
 use pdeshape_core::fit::{BSplineSurface, EdgeTolerance, FitOptions, FitReport, fit_surface};
 use pdeshape_core::num::max_nan;
@@ -167,6 +167,8 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
     // each face's last foot seeds the next (a grid search for every point costs thousands
     // of evaluations of a B-spline face)
     let mut seeds: Vec<Option<[f64; 2]>> = vec![None; faces.len()];
+    // each face's field made once (a closed B-spline face's is periodic, `FaceSurface::field`)
+    let fields: Vec<Option<_>> = faces.iter().map(|&fi| b.faces[fi].surface.as_ref().map(|s| s.field())).collect();
     for i in 0..samples {
         let v = v0 + (v1 - v0) * (i as f64 + 0.5) / samples as f64;
         let d = s.derivatives(0.0, v, 2, 2);
@@ -174,8 +176,7 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
         // the nearest face around
         let mut best: Option<(f64, usize, [f64; 2])> = None;
         for (k, &fi) in faces.iter().enumerate() {
-            let Some(fs) = &b.faces[fi].surface else { continue };
-            let field = fs.field();
+            let (Some(fs), Some(field)) = (&b.faces[fi].surface, &fields[k]) else { continue };
             // a foot outside a B-spline face's domain (the last foot carried across a closed
             // face's seam) is on its extrapolation, not on the face: from there moved by the
             // period, or searched afresh
@@ -190,17 +191,17 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
             seeds[k] = Some(c);
             let dist = (field.eval(&c) - p).norm();
             if best.is_none_or(|x| dist < x.0) {
-                best = Some((dist, fi, c));
+                best = Some((dist, k, c));
             }
         }
-        let Some((dist, fi, c)) = best else {
+        let Some((dist, k, c)) = best else {
             out.gap = f64::NAN;
             continue;
         };
         out.gap = max_nan(out.gap, dist);
-        let fs: &FaceSurface = b.faces[fi].surface.as_ref().expect("chosen among faces with surfaces");
+        let field = fields[k].as_ref().expect("chosen among faces with surfaces");
         let nd = {
-            let j = fs.field().jet(&[c[0], c[1], 0.0], pdeshape_core::jet::JetShape::new(&[2, 2]));
+            let j = field.jet(&[c[0], c[1], 0.0], pdeshape_core::jet::JetShape::new(&[2, 2]));
             // the face's derivatives in the order of `BSplineSurface::derivatives`
             let mut v = Vec::with_capacity(9);
             for a in 0..=2 {
