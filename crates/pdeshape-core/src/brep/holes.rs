@@ -93,7 +93,7 @@ fn oriented_normal(s: Option<&FaceSurface>, same_sense: bool, p: Vec3) -> Option
 fn touching(b: &Brep, tol: f64) -> Vec<usize> {
     let n = b.vertices.len();
     let mut rep: Vec<usize> = (0..n).collect();
-    if !tol.is_finite() {
+    if !(tol.is_finite() && tol > 0.0) {
         return rep;
     }
     fn root(rep: &mut [usize], mut i: usize) -> usize {
@@ -103,17 +103,28 @@ fn touching(b: &Brep, tol: f64) -> Vec<usize> {
         }
         i
     }
-    // sorted by x, pairs closer than `tol` in x are compared (NaN points stay alone)
-    let mut order: Vec<usize> = (0..n).filter(|&i| b.vertices[i].1.x.is_finite()).collect();
-    order.sort_by(|&i, &j| b.vertices[i].1.x.total_cmp(&b.vertices[j].1.x));
-    for (k, &i) in order.iter().enumerate() {
-        for &j in &order[k + 1..] {
-            if b.vertices[j].1.x - b.vertices[i].1.x > tol {
-                break;
-            }
-            if (b.vertices[j].1 - b.vertices[i].1).norm() <= tol {
-                let (ri, rj) = (root(&mut rep, i), root(&mut rep, j));
-                rep[ri.max(rj)] = ri.min(rj);
+    // points hashed to cells of side `tol`: each compared with those of its cell and
+    // the 26 around (sorting on one axis went quadratic on a model flat in that axis);
+    // NaN points and points beyond the cells' range stay alone
+    let cell = |p: Vec3| {
+        let c = [p.x / tol, p.y / tol, p.z / tol];
+        c.iter().all(|x| x.abs() < 1e15).then(|| c.map(|x| x.floor() as i64))
+    };
+    let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = std::collections::HashMap::new();
+    for i in 0..n {
+        if let Some(c) = cell(b.vertices[i].1) {
+            cells.entry(c).or_default().push(i);
+        }
+    }
+    for i in 0..n {
+        let Some(c) = cell(b.vertices[i].1) else { continue };
+        for d in 0..27 {
+            let key = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
+            for &j in cells.get(&key).map_or(&[][..], Vec::as_slice) {
+                if j > i && (b.vertices[j].1 - b.vertices[i].1).norm() <= tol {
+                    let (ri, rj) = (root(&mut rep, i), root(&mut rep, j));
+                    rep[ri.max(rj)] = ri.min(rj);
+                }
             }
         }
     }
