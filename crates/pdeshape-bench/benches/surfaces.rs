@@ -276,10 +276,42 @@ fn cad_fit(c: &mut Criterion) {
     g.finish();
 }
 
+/// The CAD issue's "a hole filled and exported" on one thread: the whole of `fill-holes
+/// MODEL --holes 1` in memory — the STEP text parsed, the holes found, hole 1 filled, its
+/// face fitted and measured, the model written back to bytes — for the OCCT suite's
+/// models (`crates/pdeshape/tests/data/step`), nothing kept between iterations (the
+/// cardinal memo emptied).
+fn step_holes(c: &mut Criterion) {
+    use pdeshape_io::holes::{FillHolesOptions, fill_holes, filled_bytes};
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../pdeshape/tests/data/step");
+    let limits = pdeshape_core::limits::Limits::default();
+    let mut g = c.benchmark_group("step fill-holes");
+    g.sample_size(10);
+    for (model, edges) in [("cylinder-open", 1), ("rounded-box-corners", 3), ("loft-open", 1), ("touching-parts", 2)] {
+        let bytes = std::fs::read(dir.join(format!("{model}.step"))).expect("the model");
+        for order in [4, 6] {
+            let opts = FillHolesOptions { order, holes: Some(vec![1]), ..Default::default() };
+            g.bench_function(
+                format!("{model} hole 1 ({edges} edges), order {order}: read + fill + fit + write"),
+                |b| {
+                    b.iter(|| {
+                        pdeshape_core::spectral::clear_cardinal_memo();
+                        let m = pdeshape_io::import::step::parse_step(bytes.clone(), model, &limits).expect("read");
+                        let holes = pdeshape_core::brep::holes(&m.brep);
+                        let filled = fill_holes(&m, &holes, &opts).expect("filled");
+                        filled_bytes(&m, &holes, &filled).expect("written")
+                    })
+                },
+            );
+        }
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     // no plots: criterion's plot backend needs system fonts
     config = Criterion::default().without_plots();
-    targets = surfaces, evaluate_million, scattered, cad_fit
+    targets = surfaces, evaluate_million, scattered, cad_fit, step_holes
 }
 criterion_main!(benches);

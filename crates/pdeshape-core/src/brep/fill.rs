@@ -10,12 +10,22 @@
 //! `τ`; with `d = ±1` the direction of `τ` along the run, the hole is on the side
 //! `−d ν` (`same_sense`) or `+d ν`, which is [`FillEdge::side`].
 //!
+//! **The foot curve, tabulated.** The foot curve is found once per piece as a piecewise
+//! Chebyshev series ([`FootSeries`], the exact feet interpolated, its distance from them
+//! measured between the nodes within [`series_tolerance`]); the fill's data are
+//! evaluated at thousands of `v` by the new face's fit, and each exact foot costs a
+//! Newton solve and a Taylor expansion. The series lies on the face, so G1/G2 to it are
+//! unchanged; where no series meets the tolerance the exact foot curve is used.
+//!
 //! A loop of fewer than three edges (a single closed edge, two arcs) is cut into three or
 //! four pieces at equal parameter steps; the cuts are not corners of the neighbours (one
 //! face on both sides), so the fill is G1 there like anywhere along the edge.
 
 use super::{Brep, Hole, HoleKind, HoleUse};
-use crate::fill::{AlongCurve, DomainCurve, Fill, FillEdge, FillError, FillOptions, FootCurve, FootError, Host};
+use crate::data::{Field, FieldRef};
+use crate::fill::{
+    AlongCurve, DomainCurve, Fill, FillEdge, FillError, FillOptions, FootCurve, FootError, FootSeries, Host,
+};
 use crate::num::max_nan;
 use std::sync::Arc;
 
@@ -124,9 +134,23 @@ pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePie
         out.offset = max_nan(out.offset, foot.max_distance());
         let dir = if tb >= ta { 1.0 } else { -1.0 };
         let side = if f.same_sense { -dir } else { dir };
-        let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(Arc::new(foot)) };
+        let domain: FieldRef = match FootSeries::new(&foot, &host, (ta, tb), t, series_tolerance(&*curve, (ta, tb))) {
+            Some(series) => Arc::new(series),
+            None => Arc::new(foot),
+        };
+        let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(domain) };
         out.edges.push(FillEdge { surface: Arc::new(along), s0: 0.0, w: (ta, tb), fullness: 1.0, side: Some(side) });
         out.ranges.push((ta, tb));
     }
     Ok(out)
+}
+
+/// How far the tabulated foot ([`FootSeries`]) may move the fill's edge along the face:
+/// 1e-13 of the edge's size (the largest coordinate of its ends and midpoint, plus its
+/// chord), a few hundred units of round-off of its coordinates. The seam tolerances of
+/// the new faces' fits are 3e-10 of the model's size and above.
+fn series_tolerance(curve: &dyn Field, (a, b): (f64, f64)) -> f64 {
+    let p = [curve.eval(&[a]), curve.eval(&[0.5 * (a + b)]), curve.eval(&[b])];
+    let size = p.iter().fold(0.0, |m, q| max_nan(m, q.norm())) + (p[2] - p[0]).norm() + (p[1] - p[0]).norm();
+    1e-13 * size
 }

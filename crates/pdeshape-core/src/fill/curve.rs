@@ -57,16 +57,9 @@ impl AlongCurve {
         match &self.curve {
             DomainCurve::Trim(c) => c.derivatives(tau, k),
             DomainCurve::Field(f) => {
-                let j = f.jet(&[tau], JetShape::new(&[k]));
-                let mut fact = 1.0;
-                (0..=k)
-                    .map(|m| {
-                        if m > 0 {
-                            fact *= m as f64;
-                        }
-                        [j.0[0].coeff([m, 0, 0]) * fact, j.0[1].coeff([m, 0, 0]) * fact]
-                    })
-                    .collect()
+                let mut d = vec![Vec3::ZERO; k + 1];
+                f.derivatives_in(&[tau], 0, &mut d);
+                d.iter().map(|x| [x.x, x.y]).collect()
             }
         }
     }

@@ -53,6 +53,7 @@ mod crease;
 mod curve;
 mod data;
 mod foot;
+mod foot_series;
 
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
@@ -62,6 +63,7 @@ use crate::spectral::{SpectralError, SpectralOptions, SpectralPatch};
 pub use curve::{AlongCurve, DomainCurve, Host};
 use data::{LoopData, Piece, second_frame};
 pub use foot::{FootCurve, FootError, foot_of};
+pub use foot_series::FootSeries;
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
