@@ -10,7 +10,7 @@ use pdeshape_core::Vec3;
 use pdeshape_core::brep::{Brep, Hole, HoleKind, HoleUse, fill_hole};
 use pdeshape_core::fill::{Fill, FillOptions, foot_of};
 use pdeshape_core::fit::{BSplineSurface, EdgeTolerance, FitOptions, FitReport, fit_surface};
-use pdeshape_core::num::max_nan;
+use pdeshape_core::num::{max_nan, min_nan};
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -34,8 +34,34 @@ pub struct HolesReport {
     pub edges: usize,
     /// Faces and edges on geometry that is not read (`#id TYPE`), by the face or edge.
     pub unsupported: Vec<String>,
+    /// Where the file's assembly places each shell (every shell at least once: a shell
+    /// outside any product structure where it is, with an empty path).
+    pub instances: Vec<InstanceReport>,
     /// The loops of the free boundary, numbered from 1.
     pub holes: Vec<HoleReport>,
+}
+
+/// One placed copy of a shell.
+#[derive(Clone, Debug, Serialize)]
+pub struct InstanceReport {
+    /// The shell's id.
+    pub shell: u64,
+    /// The products from the root assembly down to the part, `name (#id)`.
+    pub path: Vec<String>,
+    /// The motion from the part's coordinates to the model's, `[R | t]` by rows (`x ↦ R x
+    /// + t`).
+    pub placement: [[f64; 4]; 3],
+    /// The box of the shell's vertices, placed.
+    pub vertex_bbox: [[f64; 3]; 2],
+}
+
+/// A hole in one placed copy of its shell.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlacedHole {
+    /// The copy: its index in [`HolesReport::instances`].
+    pub instance: usize,
+    /// The hole's bounding box there (the same points as [`HoleReport::bbox`], placed).
+    pub bbox: [[f64; 3]; 2],
 }
 
 /// One loop of the free boundary.
@@ -58,6 +84,52 @@ pub struct HoleReport {
     pub corners: Vec<(u64, f64)>,
     /// Whether the faces meet G1 (angle ≤ [`G1_CORNER`]) at every corner.
     pub g1_corners: bool,
+    /// Its bounding box in each placed copy of its shell (a hole is a part's: filled
+    /// once, it is filled in every copy).
+    pub placed: Vec<PlacedHole>,
+}
+
+fn corners(b: (Vec3, Vec3)) -> [[f64; 3]; 2] {
+    [[b.0.x, b.0.y, b.0.z], [b.1.x, b.1.y, b.1.z]]
+}
+
+/// The reports of `m`'s placed shells.
+fn instance_reports(m: &StepModel) -> Vec<InstanceReport> {
+    let b = &m.brep;
+    // each shell's vertices, once
+    let mut of_shell: Vec<Vec<usize>> = vec![Vec::new(); b.shells.len()];
+    for f in &b.faces {
+        for &(e, _) in f.loops.iter().flatten() {
+            of_shell[f.shell].extend(b.edges[e].vertices);
+        }
+    }
+    for v in &mut of_shell {
+        v.sort_unstable();
+        v.dedup();
+    }
+    m.instances
+        .iter()
+        .map(|i| {
+            let f = &i.placement;
+            let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+            let mut hi = -lo;
+            for &v in &of_shell[i.shell] {
+                let p = f.global(b.vertices[v].1);
+                lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
+                hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
+            }
+            let row = |k: usize| {
+                let c = |v: Vec3| [v.x, v.y, v.z][k];
+                [c(f.x), c(f.y), c(f.z), c(f.o)]
+            };
+            InstanceReport {
+                shell: b.shells[i.shell].id,
+                path: i.path.clone(),
+                placement: [row(0), row(1), row(2)],
+                vertex_bbox: corners((lo, hi)),
+            }
+        })
+        .collect()
 }
 
 fn kind_name(k: HoleKind) -> &'static str {
@@ -78,6 +150,7 @@ pub fn holes_report(m: &StepModel, holes: &[Hole]) -> HolesReport {
         faces: b.faces.len(),
         edges: b.edges.len(),
         unsupported: m.unsupported.iter().map(|(id, what)| format!("#{id}: {what}")).collect(),
+        instances: instance_reports(m),
         holes: holes
             .iter()
             .enumerate()
@@ -90,6 +163,13 @@ pub fn holes_report(m: &StepModel, holes: &[Hole]) -> HolesReport {
                 bbox: [[h.bbox.0.x, h.bbox.0.y, h.bbox.0.z], [h.bbox.1.x, h.bbox.1.y, h.bbox.1.z]],
                 corners: h.corners.iter().map(|c| (b.vertices[c.vertex].0, c.angle)).collect(),
                 g1_corners: h.corners.iter().all(|c| c.angle <= G1_CORNER),
+                placed: m
+                    .instances
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, i)| i.shell == b.faces[h.uses[0].face].shell)
+                    .map(|(k, i)| PlacedHole { instance: k, bbox: corners(h.placed_bbox(b, &i.placement)) })
+                    .collect(),
             })
             .collect(),
     }

@@ -72,6 +72,24 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
     for u in &r.unsupported {
         println!("  not read (written back as it is): {u}");
     }
+    let assembly = r.instances.len() > r.shells || r.instances.iter().any(|i| i.path.len() > 1);
+    if assembly {
+        println!("an assembly: {} placed copies of the {} shell(s)", r.instances.len(), r.shells);
+        for i in &r.instances {
+            let [lo, hi] = i.vertex_bbox;
+            println!(
+                "  shell #{} at {}: vertices in [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
+                i.shell,
+                i.path.join(" / "),
+                lo[0],
+                lo[1],
+                lo[2],
+                hi[0],
+                hi[1],
+                hi[2]
+            );
+        }
+    }
     for h in &r.holes {
         let edges: Vec<String> = h.edges.iter().map(|e| format!("#{e}")).collect();
         let faces: Vec<String> = h.faces.iter().map(|e| format!("#{e}")).collect();
@@ -93,6 +111,21 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
             if h.g1_corners { "G1" } else { "not all G1" },
             worst
         );
+        if assembly {
+            for p in &h.placed {
+                let [lo, hi] = p.bbox;
+                println!(
+                    "  in the copy at {}: box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
+                    r.instances[p.instance].path.join(" / "),
+                    lo[0],
+                    lo[1],
+                    lo[2],
+                    hi[0],
+                    hi[1],
+                    hi[2]
+                );
+            }
+        }
     }
     Ok(())
 }

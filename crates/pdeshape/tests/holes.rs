@@ -262,6 +262,35 @@ fn bad_models_are_refused_with_the_entity_and_line() {
         "#24 = SURFACE_CURVE('',#24,(#30),.PCURVE_S1.);",
     );
     refused(&["holes", &s(&cycle)], 1, &["#24 SURFACE_CURVE", "a cycle?"]);
+    // assembly uses that cycle: the cylinder's product uses a product that uses itself
+    let motion = "#3006 = ( REPRESENTATION_RELATIONSHIP('','',#10,#10) REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#3008) SHAPE_REPRESENTATION_RELATIONSHIP() );\n#3008 = ITEM_DEFINED_TRANSFORMATION('','',#11,#11);";
+    let uses = |list: &[(u64, u64, u64)]| -> String {
+        list.iter()
+            .map(|(id, p, c)| {
+                format!("#{id} = NEXT_ASSEMBLY_USAGE_OCCURRENCE('u{id}','','',#{p},#{c},$);\n#{} = PRODUCT_DEFINITION_SHAPE('','',#{id});\n#{} = CONTEXT_DEPENDENT_SHAPE_REPRESENTATION(#3006,#{});\n", id + 1, id + 2, id + 1)
+            })
+            .collect()
+    };
+    let cycle = edited(
+        d,
+        "uses.step",
+        "#5 = PRODUCT_DEFINITION('design','',#6,#9);",
+        &format!(
+            "#5 = PRODUCT_DEFINITION('design','',#6,#9);\n#3000 = PRODUCT_DEFINITION('a','',#6,#9);\n{motion}\n{}",
+            uses(&[(3010, 5, 3000), (3020, 3000, 3000)])
+        ),
+    );
+    refused(&["holes", &s(&cycle)], 1, &["uses.step:", "PRODUCT_DEFINITION", "nested deeper than 64"]);
+    // 17 levels of assemblies each using the next twice: 2¹⁷ copies of the cylinder,
+    // refused at the cap before they are all made
+    let mut text = format!("#5 = PRODUCT_DEFINITION('design','',#6,#9);\n{motion}\n");
+    let level = |k: u64| if k == 17 { 5 } else { 4000 + k };
+    for k in 0..17u64 {
+        text += &format!("#{} = PRODUCT_DEFINITION('l{k}','',#6,#9);\n", level(k));
+        text += &uses(&[(5000 + 10 * k, level(k), level(k + 1)), (6000 + 10 * k, level(k), level(k + 1))]);
+    }
+    let many = edited(d, "many.step", "#5 = PRODUCT_DEFINITION('design','',#6,#9);", &text);
+    refused(&["holes", &s(&many)], 1, &["many.step:", "places more than 100000 copies"]);
     // caps
     let cyl = s(&model("cylinder-open.step"));
     refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);
@@ -693,4 +722,56 @@ fn the_gap_between_touching_parts_is_filled() {
         &["split.step: hole 1: it runs along faces of the shells #16 and #99999", "not written"],
     );
     assert!(!refused_out.exists());
+}
+
+/// The CAx-IF AS1 assembly (UG through Theorem's translator) places its five parts 18
+/// times: counted by hand from the file's assembly uses — the rod assembly holds a rod and
+/// two nuts; each of the two L-bracket assemblies an L-bracket and three nut-bolt
+/// assemblies of a bolt and a nut each; the plate once — so the nut 8 times, the bolt 6,
+/// the L-bracket 2. A side of the nut (face #209, a 20 × 3 rectangle in the nut's
+/// coordinates) taken out leaves one hole, reported in each of the nut's 8 copies: each
+/// copy's box is the rectangle moved (extents 0, 3 and 20 in some order: the assembly's
+/// motions turn by multiples of 90° about the axes the nut is used along) and lies in the
+/// box of that copy's vertices. (OpenCASCADE places the same parts at the same places:
+/// `test_assembly_placements` of the OCCT suite.)
+#[test]
+fn an_assembly_places_each_part_in_every_copy() {
+    let input = model("third-party/as1-ug-theorem.stp");
+    let o = run(&["holes", input.to_str().unwrap(), "--json", "--replace-faces", "209"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let instances = j["instances"].as_array().unwrap();
+    let mut copies = std::collections::BTreeMap::new();
+    for i in instances {
+        *copies.entry(i["shell"].as_u64().unwrap()).or_insert(0) += 1;
+        assert_eq!(i["path"][0], "as1 (#15)", "{i}");
+    }
+    // shells: nut #294, rod #442, bolt #706, L-bracket #1344, plate #2067
+    assert_eq!(copies, [(294, 8), (442, 1), (706, 6), (1344, 2), (2067, 1)].into_iter().collect());
+    let holes = j["holes"].as_array().unwrap();
+    assert_eq!(holes.len(), 1);
+    let placed = holes[0]["placed"].as_array().unwrap();
+    assert_eq!(placed.len(), 8);
+    let v = |x: &serde_json::Value| -> Vec<f64> { x.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect() };
+    for p in placed {
+        let (lo, hi) = (v(&p["bbox"][0]), v(&p["bbox"][1]));
+        let mut ext: Vec<f64> = (0..3).map(|k| hi[k] - lo[k]).collect();
+        ext.sort_by(f64::total_cmp);
+        // rotations by multiples of 90° written as cosines and sines of the file's
+        // directions: round-off of coordinates of size ~200
+        for (e, want) in ext.iter().zip([0.0, 3.0, 20.0]) {
+            assert!((e - want).abs() < 1e-12, "{p}: extents {ext:?}");
+        }
+        let copy = &instances[p["instance"].as_u64().unwrap() as usize];
+        assert_eq!(copy["shell"], 294);
+        let (vlo, vhi) = (v(&copy["vertex_bbox"][0]), v(&copy["vertex_bbox"][1]));
+        for k in 0..3 {
+            assert!(lo[k] >= vlo[k] - 1e-12 && hi[k] <= vhi[k] + 1e-12, "{p} outside {copy}");
+        }
+    }
+    // the copies are at different places
+    let mut at: Vec<String> = placed.iter().map(|p| format!("{:.6}", p["bbox"])).collect();
+    at.sort();
+    at.dedup();
+    assert_eq!(at.len(), 8);
 }

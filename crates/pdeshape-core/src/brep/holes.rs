@@ -16,6 +16,7 @@
 
 use super::{Brep, FaceSurface};
 use crate::Vec3;
+use crate::data::analytic::Frame;
 use crate::fill::foot_of;
 use crate::jet::JetShape;
 use crate::num::{max_nan, min_nan};
@@ -68,7 +69,29 @@ pub struct Hole {
     pub bbox: (Vec3, Vec3),
 }
 
+/// The bounding box of 33 points per edge of `uses` (ends included), each placed by
+/// `placement` (its frame coordinates are the model's points).
+fn edge_box(b: &Brep, uses: &[HoleUse], placement: &Frame) -> (Vec3, Vec3) {
+    let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    for u in uses {
+        let e = &b.edges[u.edge];
+        for i in 0..=32 {
+            let p = placement.global(e.point(e.range.0 + (e.range.1 - e.range.0) * i as f64 / 32.0));
+            lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
+            hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
+        }
+    }
+    (lo, hi)
+}
+
 impl Hole {
+    /// The bounding box of the hole placed by `placement` (a copy of its part placed by
+    /// an assembly): the same points as [`Hole::bbox`], moved.
+    pub fn placed_bbox(&self, b: &Brep, placement: &Frame) -> (Vec3, Vec3) {
+        edge_box(b, &self.uses, placement)
+    }
+
     /// The faces around, each once, in loop order.
     pub fn faces(&self) -> Vec<usize> {
         let mut out: Vec<usize> = Vec::new();
@@ -221,18 +244,8 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
         if kind == HoleKind::Simple && passed.windows(2).any(|w| w[0] == w[1]) {
             kind = HoleKind::TouchesItself;
         }
-        let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
-        let mut hi = -lo;
-        let mut length = 0.0;
-        for u in &uses {
-            let e = &b.edges[u.edge];
-            length += e.length();
-            for i in 0..=32 {
-                let p = e.point(e.range.0 + (e.range.1 - e.range.0) * i as f64 / 32.0);
-                lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
-                hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
-            }
-        }
+        let length: f64 = uses.iter().map(|u| b.edges[u.edge].length()).sum();
+        let (lo, hi) = edge_box(b, &uses, &Frame::WORLD);
         let corners = if kind == HoleKind::Open {
             Vec::new()
         } else {

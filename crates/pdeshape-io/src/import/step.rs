@@ -30,14 +30,20 @@ use std::path::Path;
 use std::sync::Arc;
 use step_io::parser::{Attribute, Graph, RawEntity, RawEntityPart};
 
+mod assembly;
+pub use assembly::{MAX_INSTANCES, ShellInstance};
+
 /// A read STEP model.
 pub struct StepModel {
     /// The file's name as given.
     pub file: String,
     /// The file's bytes (written back unchanged but for the shells that get new faces).
     pub source: Vec<u8>,
-    /// The B-rep of all its shells.
+    /// The B-rep of all its shells, each in its part's coordinates.
     pub brep: Brep,
+    /// Where the assembly places each shell, and how many times (every shell at least
+    /// once; see [`ShellInstance`]).
+    pub instances: Vec<ShellInstance>,
     /// The length unit: its name and its size in metres.
     pub unit: (String, f64),
     /// Faces and edges whose geometry is not read: `(#id, type)` of the face or edge
@@ -172,6 +178,7 @@ pub fn parse_step(source: Vec<u8>, file: &str, limits: &Limits) -> Result<StepMo
     for (id, closed) in shells {
         r.shell(id, closed)?;
     }
+    let instances = r.instances()?;
     let mut spans = BTreeMap::new();
     let mut types = BTreeMap::new();
     let mut users: HashMap<u64, Vec<u64>> = HashMap::new();
@@ -220,6 +227,7 @@ pub fn parse_step(source: Vec<u8>, file: &str, limits: &Limits) -> Result<StepMo
         file: file.to_string(),
         source,
         brep: r.brep,
+        instances,
         unit,
         unsupported: r.unsupported,
         spans,

@@ -37,6 +37,7 @@ from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.Extrema import Extrema_ExtAlgo
+from OCP.IFSelect import IFSelect_RetDone
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Vec
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
@@ -270,7 +271,8 @@ def test_third_party_model(name, tmp_path):
     reads as many solids as in the input, valid, without free edges; every input face but
     the ones taken out is found in the output with its surface type and area (to 1e-9);
     the new faces' edges within the issue's bounds. (AS1 is an assembly: OCCT places its
-    parts' instances, so each face of the plate appears once per instance.)"""
+    parts' instances, so each face of the nut, whose hole is filled, appears once per
+    instance: 8 times.)"""
     src = THIRD_PARTY / name
     before, after = fill_replacing(src, tmp_path / "filled.step", THIRD_PARTY_MODELS[name])
     assert BRepCheck_Analyzer(after).IsValid()
@@ -294,3 +296,82 @@ def test_third_party_model(name, tmp_path):
     assert gap < 1e-9 * size(before), gap
     assert angle < 1e-8, angle
     assert krel < 1e-6, krel
+
+
+def xcaf_assembly(path):
+    """An assembly OCCT writes (XCAF, `STEPCAFControl_Writer`): a 1 × 2 × 3 box used
+    twice in a sub-assembly, turned about three different axes and moved; the
+    sub-assembly used twice in the top one (once turned and moved, once where it is), and
+    the box once more on its own: five copies, nested two deep."""
+    import math
+
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.STEPCAFControl import STEPCAFControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf
+
+    def motion(axis, angle, shift):
+        r, t = gp_Trsf(), gp_Trsf()
+        r.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(*axis)), angle)
+        t.SetTranslation(gp_Vec(*shift))
+        return TopLoc_Location(t.Multiplied(r))
+
+    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    part = tool.AddShape(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), False)
+    sub = tool.NewShape()
+    tool.AddComponent(sub, part, motion((0, 0, 1), math.pi / 2, (10, 0, 0)))
+    tool.AddComponent(sub, part, motion((1, 1, 0), 0.7, (0, 5, 1)))
+    top = tool.NewShape()
+    tool.AddComponent(top, sub, motion((0, 1, 0), 0.3, (-4, 2, 7)))
+    tool.AddComponent(top, sub, TopLoc_Location())
+    tool.AddComponent(top, part, motion((1, 0, 0), -1.1, (3, 3, 3)))
+    tool.UpdateAssemblies()
+    w = STEPCAFControl_Writer()
+    assert w.Transfer(doc, STEPControl_AsIs)
+    assert w.Write(str(path)) == IFSelect_RetDone
+    return path
+
+
+def vertex_boxes(shape):
+    """The box of each solid's vertices, as OCCT places the solids."""
+    from OCP.TopAbs import TopAbs_VERTEX
+    from OCP.TopoDS import TopoDS
+
+    out = []
+    ex = TopExp_Explorer(shape, TopAbs_SOLID)
+    while ex.More():
+        pts = []
+        ev = TopExp_Explorer(ex.Current(), TopAbs_VERTEX)
+        while ev.More():
+            p = BRep_Tool.Pnt_s(TopoDS.Vertex(ev.Current()))
+            pts.append((p.X(), p.Y(), p.Z()))
+            ev.Next()
+        out.append([min(q[k] for q in pts) for k in range(3)] + [max(q[k] for q in pts) for k in range(3)])
+        ex.Next()
+    return out
+
+
+@pytest.mark.parametrize("name", ["as1", "xcaf"])
+def test_assembly_placements(name, tmp_path):
+    """Each part copy `holes --json` places (its `vertex_bbox`) is one of the solids
+    OpenCASCADE places when it reads the same file, one for one: the CAx-IF AS1 assembly
+    (UG through Theorem, 18 copies of 5 parts, three levels) and an assembly OCCT writes
+    itself (5 copies, two levels, turns about oblique axes)."""
+    src = THIRD_PARTY / "as1-ug-theorem.stp" if name == "as1" else xcaf_assembly(tmp_path / "asm.step")
+    theirs = vertex_boxes(read(src))
+    r = subprocess.run([cli(), "holes", str(src), "--json"], capture_output=True, check=True)
+    ours = [i["vertex_bbox"][0] + i["vertex_bbox"][1] for i in json.loads(r.stdout)["instances"]]
+    assert len(ours) == len(theirs) == {"as1": 18, "xcaf": 5}[name]
+    scale = max(max(abs(x) for x in b) for b in theirs)
+    for b in theirs:
+        d = [max(abs(x - y) for x, y in zip(b, m)) for m in ours]
+        k = min(range(len(d)), key=d.__getitem__)
+        # both compose the file's placements in double precision: seen 0 (AS1, turns
+        # by multiples of 90°) and 8.9e-16 (the oblique turns)
+        assert d[k] <= 1e-13 * scale, (b, ours[k])
+        ours.pop(k)
