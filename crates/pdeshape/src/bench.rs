@@ -58,7 +58,7 @@ pub fn run(runs: usize, json_out: bool, out: Option<&Path>, limits: Limits) -> R
     let mut md = markdown(&t1, &acc, runs);
     md.push_str(&trim_markdown(&t3, runs.max(5)));
     if json_out {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         print!("{md}");
     }

@@ -15,13 +15,13 @@ pub fn command(sc: &Scene, json: bool, cad: bool, degree: Option<usize>) -> Resu
     // a report with a NaN or inf is an error, not a `null` among the figures
     check_finite_report(&d)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&d)?);
+        outln!("{}", serde_json::to_string_pretty(&d)?);
     } else {
-        print_check(sc, &d);
+        print_check(sc, &d)?;
         if let Some(f) = &fitted {
-            println!("  CAD (STEP) faces:");
+            outln!("  CAD (STEP) faces:");
             for line in cad_lines(f) {
-                println!("    {line}");
+                outln!("    {line}");
             }
         }
     }
@@ -83,10 +83,10 @@ pub fn not_finite(patch: &str) -> String {
 }
 
 /// The text report of `check`.
-fn print_check(sc: &Scene, d: &SceneReport) {
-    println!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
+fn print_check(sc: &Scene, d: &SceneReport) -> Result<()> {
+    outln!("scene {}{}", sc.name, sc.title.as_ref().map(|t| format!(": {t}")).unwrap_or_default());
     for p in &d.patches {
-        println!(
+        outln!(
             "  patch {:<16} kind {:<10} solver {:<22} conditions {:>2}  max condition error {:.2e} abs, {:.2e} rel",
             p.name,
             p.kind.name(),
@@ -96,7 +96,7 @@ fn print_check(sc: &Scene, d: &SceneReport) {
             p.condition_error.max_rel,
         );
         if let Some(sp) = &p.spectral {
-            println!(
+            outln!(
                 "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}, truncated-part residual {:.1e} (relative)",
                 sp.order,
                 sp.modes,
@@ -109,10 +109,10 @@ fn print_check(sc: &Scene, d: &SceneReport) {
             );
         }
         if let Some(line) = continuity_line(p) {
-            println!("      {line}");
+            outln!("      {line}");
         }
         if let Some(f) = &p.fill {
-            println!(
+            outln!(
                 "      fill (order {}): {} edges, {} points: G1 angle ≤ {:.1e} rad, gap ≤ {:.1e}, curvature gap ≤ {:.1e} (relative); folds {}; pole {}",
                 f.order,
                 f.edges,
@@ -125,7 +125,7 @@ fn print_check(sc: &Scene, d: &SceneReport) {
             );
         }
         if let (Some(so), Some(mp)) = (&p.solid, &p.mass_properties) {
-            println!(
+            outln!(
                 "      terms {}, condition {:.2e}, RMS residual {:.3e}; volume {:.6}, centroid {}, det J in [{:.3e}, {:.3e}]",
                 json_text(&so.terms),
                 so.condition_number,
@@ -138,7 +138,7 @@ fn print_check(sc: &Scene, d: &SceneReport) {
         }
         if let Some(b) = &p.blend {
             for c in &b.components {
-                println!(
+                outln!(
                     "      {}: order {}, solver {}, {} basis functions, condition {:.2e}{}",
                     c.component,
                     c.order,
@@ -151,20 +151,21 @@ fn print_check(sc: &Scene, d: &SceneReport) {
                 );
             }
             if let Some(x) = b.exact_vs_collocation_max_distance {
-                println!("      max distance between the exact and the collocation solution: {x:.3e}");
+                outln!("      max distance between the exact and the collocation solution: {x:.3e}");
             }
         }
         if let Some(x) = p.section_reference_distance {
             let lin = p.section_reference_distance_linear_s.unwrap_or(f64::NAN);
-            println!(
+            outln!(
                 "      max distance to the section family at the fractional section index: {x:.4} \
                      (s linear in u between sections: {lin:.4})"
             );
         }
         for w in &p.warnings {
-            println!("      warning: {w}");
+            outln!("      warning: {w}");
         }
     }
+    Ok(())
 }
 
 /// A small array as compact JSON (`[1.0,2.0,3.0]`), the way the text report has always

@@ -343,6 +343,14 @@ pub fn run() -> i32 {
     }
     match result {
         Ok(()) => 0,
+        // the reader of stdout closed it (`| head`): it wanted no more
+        Err(e)
+            if e.chain().any(|c| {
+                c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            }) =>
+        {
+            0
+        }
         Err(e) => {
             // hostile input echoed in the message is escaped and cut (a scene's keys can
             // hold escapes; a message is at most 4000 characters)

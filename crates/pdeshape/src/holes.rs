@@ -57,10 +57,10 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
     let hs = holes(&m.brep);
     let r = holes_report(&m, &hs);
     if json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        outln!("{}", serde_json::to_string_pretty(&r)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {} shell(s), {} faces, {} edges; lengths in {}; {} loop(s) of free edges",
         r.file,
         r.shells,
@@ -70,14 +70,14 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
         r.holes.len()
     );
     for u in &r.unsupported {
-        println!("  not read (written back as it is): {u}");
+        outln!("  not read (written back as it is): {u}");
     }
     let assembly = r.instances.len() > r.shells || r.instances.iter().any(|i| i.path.len() > 1);
     if assembly {
-        println!("an assembly: {} placed copies of the {} shell(s)", r.instances.len(), r.shells);
+        outln!("an assembly: {} placed copies of the {} shell(s)", r.instances.len(), r.shells);
         for i in &r.instances {
             let [lo, hi] = i.vertex_bbox;
-            println!(
+            outln!(
                 "  shell #{} at {}: vertices in [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
                 i.shell,
                 i.path.join(" / "),
@@ -94,7 +94,7 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
         let edges: Vec<String> = h.edges.iter().map(|e| format!("#{e}")).collect();
         let faces: Vec<String> = h.faces.iter().map(|e| format!("#{e}")).collect();
         let worst = h.corners.iter().fold(0.0, |a: f64, c| pdeshape_core::num::max_nan(a, c.1));
-        println!(
+        outln!(
             "hole {}: {}, {} edge(s) [{}], faces [{}], length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}], corners {} (largest angle {:.3e} rad)",
             h.index,
             h.kind,
@@ -114,7 +114,7 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
         if assembly {
             for p in &h.placed {
                 let [lo, hi] = p.bbox;
-                println!(
+                outln!(
                     "  in the copy at {}: box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
                     r.instances[p.instance].path.join(" / "),
                     lo[0],
@@ -198,10 +198,10 @@ fn list_mesh(path: &Path, json: bool, limits: &Limits) -> Result<()> {
     let (mf, loops) = read_checked(path, limits)?;
     let r = mesh_holes_report(&mf, &loops);
     if json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        outln!("{}", serde_json::to_string_pretty(&r)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {} mesh, {} vertices, {} triangles{}; dihedral angles' 99th percentile {:.3e} rad; {} boundary loop(s)",
         r.file,
         r.format,
@@ -212,7 +212,7 @@ fn list_mesh(path: &Path, json: bool, limits: &Limits) -> Result<()> {
         r.holes.len()
     );
     for h in &r.holes {
-        println!(
+        outln!(
             "hole {}: {} (facing {:+.2}), {} edges from vertex {}, length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
             h.index,
             h.kind,

@@ -1,6 +1,16 @@
 //! `pdeshape`: the command-line tool. A thin layer over `pdeshape-core` (mathematics) and
 //! `pdeshape-io` (scene files, exporters, pictures).
 
+/// `println!` that hands the write's error to the caller (`?`) instead of panicking: a
+/// reader that closes the pipe early (`pdeshape holes … | head`) ends the command quietly
+/// ([`cli::run`] exits 0 on a broken pipe, as `head` wanted no more).
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($t)*)?
+    }};
+}
+
 mod bench;
 mod build;
 mod check;

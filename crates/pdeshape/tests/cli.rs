@@ -277,3 +277,24 @@ fn sample_evaluates_a_primary_surfaces_face() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("surface-nope"));
 }
+
+/// A reader that closes stdout before the report is written (`pdeshape holes … | head`)
+/// ends the command quietly: exit 0, no panic on stderr. (The pipe's read end is closed
+/// as soon as the process starts; reading the model takes it far longer than that.)
+#[test]
+fn a_closed_stdout_ends_the_command_quietly() {
+    let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/step/third-party/as1-ug-theorem.stp");
+    for args in [vec!["holes", model.to_str().unwrap()], vec!["check", example("dolphin.toml").to_str().unwrap()]] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("pdeshape"))
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}

@@ -272,7 +272,7 @@ pub fn run(o: ServeOptions) -> Result<()> {
             .await
             .with_context(|| format!("cannot listen on {}:{}", o.host, o.port))?;
         let addr = listener.local_addr()?;
-        println!("pdeshape editor: http://{addr}/");
+        outln!("pdeshape editor: http://{addr}/");
         use std::io::Write as _;
         std::io::stdout().flush().ok();
         let listener = idle::IdleListener::new(listener, o.time_limit.saturating_add(IDLE_GRACE));
