@@ -76,18 +76,7 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
     if assembly {
         outln!("an assembly: {} placed copies of the {} shell(s)", r.instances.len(), r.shells);
         for i in &r.instances {
-            let [lo, hi] = i.vertex_bbox;
-            outln!(
-                "  shell #{} at {}: vertices in [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
-                i.shell,
-                i.path.join(" / "),
-                lo[0],
-                lo[1],
-                lo[2],
-                hi[0],
-                hi[1],
-                hi[2]
-            );
+            outln!("  shell #{} at {}: vertices in {}", i.shell, i.path.join(" / "), boxed(&i.vertex_bbox));
         }
     }
     for h in &r.holes {
@@ -95,39 +84,29 @@ pub fn list(path: &Path, json: bool, replace: &[u64], limits: &Limits) -> Result
         let faces: Vec<String> = h.faces.iter().map(|e| format!("#{e}")).collect();
         let worst = h.corners.iter().fold(0.0, |a: f64, c| pdeshape_core::num::max_nan(a, c.1));
         outln!(
-            "hole {}: {}, {} edge(s) [{}], faces [{}], length {:.6}, box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}], corners {} (largest angle {:.3e} rad)",
+            "hole {}: {}, {} edge(s) [{}], faces [{}], length {:.6}, box {}, corners {} (largest angle {:.3e} rad)",
             h.index,
             h.kind,
             h.edges.len(),
             edges.join(" "),
             faces.join(" "),
             h.length,
-            h.bbox[0][0],
-            h.bbox[0][1],
-            h.bbox[0][2],
-            h.bbox[1][0],
-            h.bbox[1][1],
-            h.bbox[1][2],
+            boxed(&h.bbox),
             if h.g1_corners { "G1" } else { "not all G1" },
             worst
         );
         if assembly {
             for p in &h.placed {
-                let [lo, hi] = p.bbox;
-                outln!(
-                    "  in the copy at {}: box [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]",
-                    r.instances[p.instance].path.join(" / "),
-                    lo[0],
-                    lo[1],
-                    lo[2],
-                    hi[0],
-                    hi[1],
-                    hi[2]
-                );
+                outln!("  in the copy at {}: box {}", r.instances[p.instance].path.join(" / "), boxed(&p.bbox));
             }
         }
     }
     Ok(())
+}
+
+/// A box as `holes` prints it: `[x, y, z] – [x, y, z]`, six decimals.
+fn boxed([lo, hi]: &[[f64; 3]; 2]) -> String {
+    format!("[{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}]", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2])
 }
 
 /// `pdeshape fill-holes MODEL -o OUT [--order 4|6] [--holes I,J | --max-edges N]
