@@ -19,6 +19,7 @@
 pub mod blend;
 pub mod brep;
 pub mod cancel;
+pub mod classes;
 pub mod data;
 pub mod expr;
 pub mod fill;

@@ -216,25 +216,17 @@ pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
     // faces that meet along an edge are refitted from the union of their v breakpoints
     // until they share them (knots only grow, so this ends): their common edge is then
     // one curve and, with the cross derivatives interpolated at the ends, one tangent plane
-    let mut group: Vec<usize> = (0..out.len()).collect();
-    fn root(g: &mut [usize], mut k: usize) -> usize {
-        while g[k] != k {
-            g[k] = g[g[k]];
-            k = g[k];
-        }
-        k
-    }
+    let mut group = pdeshape_core::classes::Classes::new(out.len());
     for s in seams(&out, 9) {
         // a solid's faces have their knots already
         if s.faces.iter().any(|f| jobs[f.0].solid.is_some()) {
             continue;
         }
-        let (a, b) = (root(&mut group, s.faces[0].0), root(&mut group, s.faces[1].0));
-        group[a] = b;
+        group.join(s.faces[0].0, s.faces[1].0);
     }
     let breaks = |f: &CadFace| f.surface.v.breakpoints();
     for r in 0..out.len() {
-        let mut members: Vec<usize> = (0..out.len()).filter(|&k| root(&mut group, k) == r).collect();
+        let mut members: Vec<usize> = (0..out.len()).filter(|&k| group.of(k) == r).collect();
         if members.len() < 2 {
             continue;
         }

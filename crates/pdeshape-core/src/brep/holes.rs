@@ -16,6 +16,7 @@
 
 use super::{Brep, FaceSurface};
 use crate::Vec3;
+use crate::classes::Classes;
 use crate::data::analytic::Frame;
 use crate::fill::foot_of;
 use crate::jet::JetShape;
@@ -30,6 +31,15 @@ pub struct HoleUse {
     pub forward: bool,
     /// The face (index into [`Brep::faces`]).
     pub face: usize,
+}
+
+impl HoleUse {
+    /// The vertices (indices into [`Brep::vertices`]) the face's run of the edge starts
+    /// and ends at.
+    pub fn ends(&self, b: &Brep) -> (usize, usize) {
+        let v = b.edges[self.edge].vertices;
+        if self.forward { (v[0], v[1]) } else { (v[1], v[0]) }
+    }
 }
 
 /// What a loop of free edges is.
@@ -115,16 +125,9 @@ fn oriented_normal(s: Option<&FaceSurface>, same_sense: bool, p: Vec3) -> Option
 /// one point where parts touch.
 fn touching(b: &Brep, tol: f64) -> Vec<usize> {
     let n = b.vertices.len();
-    let mut rep: Vec<usize> = (0..n).collect();
+    let mut rep = Classes::new(n);
     if !(tol.is_finite() && tol > 0.0) {
-        return rep;
-    }
-    fn root(rep: &mut [usize], mut i: usize) -> usize {
-        while rep[i] != i {
-            rep[i] = rep[rep[i]];
-            i = rep[i];
-        }
-        i
+        return rep.all();
     }
     // points hashed to cells of side `tol`: each compared with those of its cell and
     // the 26 around (sorting on one axis went quadratic on a model flat in that axis);
@@ -145,13 +148,12 @@ fn touching(b: &Brep, tol: f64) -> Vec<usize> {
             let key = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
             for &j in cells.get(&key).map_or(&[][..], Vec::as_slice) {
                 if j > i && (b.vertices[j].1 - b.vertices[i].1).norm() <= tol {
-                    let (ri, rj) = (root(&mut rep, i), root(&mut rep, j));
-                    rep[ri.max(rj)] = ri.min(rj);
+                    rep.join(i, j);
                 }
             }
         }
     }
-    (0..n).map(|i| root(&mut rep, i)).collect()
+    rep.all()
 }
 
 /// The unit tangent of `u` at its start (`end = false`) or end, in the direction the face
@@ -179,10 +181,7 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
         }
     }
     let free: Vec<HoleUse> = (0..b.edges.len()).filter(|&e| count[e] == 1).filter_map(|e| owner[e]).collect();
-    let ends = |u: &HoleUse| {
-        let v = b.edges[u.edge].vertices;
-        if u.forward { (v[0], v[1]) } else { (v[1], v[0]) }
-    };
+    let ends = |u: &HoleUse| u.ends(b);
     // (a NaN size merges nothing)
     let rep = touching(b, 1e-7 * b.size());
     let at_rep = |u: &HoleUse| {

@@ -46,32 +46,19 @@ pub struct SewnFace<'a> {
 pub fn sewn_step(m: &StepModel, faces: &[SewnFace], tol: f64) -> Result<Vec<u8>, String> {
     let b = &m.brep;
     let mut e = Entities { text: String::new(), next: m.max_id as usize };
-    let start_of = |u: &pdeshape_core::brep::HoleUse| {
-        let v = b.edges[u.edge].vertices;
-        if u.forward { v[0] } else { v[1] }
-    };
-    let end_of = |u: &pdeshape_core::brep::HoleUse| {
-        let v = b.edges[u.edge].vertices;
-        if u.forward { v[1] } else { v[0] }
-    };
+    let start_of = |u: &pdeshape_core::brep::HoleUse| u.ends(b).0;
+    let end_of = |u: &pdeshape_core::brep::HoleUse| u.ends(b).1;
     // where a hole passes from one part to another that touches it (two vertex entities
     // at one point, `brep::holes`), the vertices become one — the smallest index of each
     // such class — so that each new face's loop runs through shared vertices
-    let mut same: Vec<usize> = (0..b.vertices.len()).collect();
-    let root = |same: &mut Vec<usize>, mut i: usize| {
-        while same[i] != i {
-            i = same[i];
-        }
-        i
-    };
+    let mut same = pdeshape_core::classes::Classes::new(b.vertices.len());
     for f in faces {
         let uses = &f.hole.uses;
         for k in 0..uses.len() {
-            let (a, c) = (root(&mut same, end_of(&uses[k])), root(&mut same, start_of(&uses[(k + 1) % uses.len()])));
-            same[a.max(c)] = a.min(c);
+            same.join(end_of(&uses[k]), start_of(&uses[(k + 1) % uses.len()]));
         }
     }
-    let same: Vec<usize> = (0..same.len()).map(|i| root(&mut same, i)).collect();
+    let same = same.all();
     // (shell id, new face ids)
     let mut added: Vec<(u64, Vec<usize>, bool)> = Vec::new();
     for f in faces {
