@@ -123,11 +123,23 @@ impl Field for AlongCurve {
             nu.push(-c[m + 1][1] / fact);
             nv.push(c[m + 1][0] / fact);
         }
-        let s_jet = Jet::variable(shape, 0, sigma);
-        let t_jet = Jet::variable(shape, 1, tau);
-        let du = t_jet.compose(&cu).add(&s_jet.mul(&t_jet.compose(&nu))).add_scalar(-u0);
-        let dv = t_jet.compose(&cv).add(&s_jet.mul(&t_jet.compose(&nv))).add_scalar(-v0);
-        let mut out = [Jet::constant(shape, 0.0), Jet::constant(shape, 0.0), Jet::constant(shape, 0.0)];
+        // δu(σ, τ) = c₁(τ) + σ ν₁(τ) − u₀ as a jet in (δσ, δτ): the Taylor coefficients
+        // of c₁ + σ₀ ν₁ along τ, those of ν₁ one order up in σ (the value cancels u₀)
+        let offset = |c: &[f64], n: &[f64]| {
+            let mut x = vec![0.0; shape.len()];
+            for j in 1..=kw {
+                x[shape.index([0, j, 0])] = c[j] + sigma * n[j];
+                if ks >= 1 {
+                    x[shape.index([1, j, 0])] = n[j];
+                }
+            }
+            if ks >= 1 {
+                x[shape.index([1, 0, 0])] = n[0];
+            }
+            Jet::from_coeffs(shape, x)
+        };
+        let (du, dv) = (offset(&cu, &nu), offset(&cv, &nv));
+        let mut out = [vec![0.0; shape.len()], vec![0.0; shape.len()], vec![0.0; shape.len()]];
         let mut du_pow = Jet::constant(shape, 1.0);
         for i in 0..=k {
             if i > 0 {
@@ -140,11 +152,13 @@ impl Field for AlongCurve {
                 }
                 let coef = d[i * (k + 1) + j];
                 for (o, x) in out.iter_mut().zip([coef.x, coef.y, coef.z]) {
-                    *o = o.add(&term.scale(x));
+                    for (a, t) in o.iter_mut().zip(term.coeffs()) {
+                        *a += x * t;
+                    }
                 }
             }
         }
-        VecJet(out)
+        VecJet(out.map(|c| Jet::from_coeffs(shape, c)))
     }
 }
 
