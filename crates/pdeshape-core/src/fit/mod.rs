@@ -230,8 +230,8 @@ fn interpolate(k: &Knots, xs: &[(f64, usize)], rhs: &[Vec<Vec3>]) -> Result<Vec<
 /// Interpolates `s` at the Greville points of `(ku, kv)`.
 fn fit_on(s: &dyn Surface, ku: &Knots, kv: &Knots) -> Result<BSplineSurface, FitError> {
     let (gu, gv) = (ku.greville(), kv.greville());
-    let g = s.grid(&gu, &gv);
-    let mut samples: Vec<Vec<Vec3>> = g.chunks(gv.len()).map(|row| row.iter().map(|x| x[0]).collect()).collect();
+    let g = s.grid_values(&gu, &gv);
+    let mut samples: Vec<Vec<Vec3>> = g.chunks(gv.len()).map(<[Vec3]>::to_vec).collect();
     // in u, the rows next to the ends interpolate the cross derivative X_u at u = 0 and 1
     // instead of X at their Greville points (clamped-end conditions): the face's edge
     // tangent plane is then the interpolant of the patch's, the same for every face that
@@ -344,9 +344,9 @@ fn cell_deviations(s: &dyn Surface, b: &BSplineSurface, tol: f64) -> (Vec<(f64, 
             .clone()
             .flat_map(|i| (0..K).map(move |a| bu[i] + (bu[i + 1] - bu[i]) * a as f64 / (K - 1) as f64))
             .collect();
-        let exact = s.grid(&us, &vs);
+        let exact = s.grid_values(&us, &vs);
         let spline = spline_grid(b, &us, &vs);
-        let d: Vec<f64> = exact.iter().zip(&spline).map(|(x, y)| (x[0] - *y).scaled_norm()).collect();
+        let d: Vec<f64> = exact.iter().zip(&spline).map(|(x, y)| (*x - *y).scaled_norm()).collect();
         for chunk in d.chunks(K * nvs) {
             dev.push(chunk.to_vec());
         }

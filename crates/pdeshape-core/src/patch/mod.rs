@@ -92,6 +92,13 @@ pub trait Surface: Send + Sync {
         }
     }
 
+    /// Values `X` on the grid `us × vs` (row-major in `u`): the first of [`grid`](Self::grid)'s
+    /// four, for callers that need no derivatives (the fit's samples); solvers whose grids
+    /// are matrix products override it to form the values' product alone.
+    fn grid_values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
+        self.grid(us, vs).into_iter().map(|x| x[0]).collect()
+    }
+
     /// Values and first derivatives `[X, X_u, X_v, X_uv]` on the grid `us × vs` (row-major
     /// in `u`). Solvers override this to share per-row and per-column work.
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {

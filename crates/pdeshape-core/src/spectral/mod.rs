@@ -511,6 +511,10 @@ impl Surface for SpectralPatch {
         self.grid_products(us, vs, [(0, 0), (1, 0), (0, 1), (1, 1)])
     }
 
+    fn grid_values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
+        self.grid_products(us, vs, [(0, 0)]).into_iter().map(|[x]| x).collect()
+    }
+
     fn grid2(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 6]> {
         self.grid_products(us, vs, [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)])
     }
