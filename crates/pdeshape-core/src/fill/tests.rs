@@ -336,3 +336,21 @@ fn creases_inside_edges_become_corners_and_the_tear_measure_sees_a_tear() {
     let (tear, at) = torn.tear(41, 4000);
     assert!(tear > 5.0, "the unsplit fill's tear ratio is only {tear} at {at:?}");
 }
+
+/// A fill's values-only grid (the fit's samples: the loop data's values through their
+/// fast paths) against its full grid (the data with `v`-derivatives through jets), at
+/// orders 4 and 6 on the sphere's pentagon hole: the same values to round-off.
+#[test]
+fn a_fills_value_grid_is_its_full_grids_first_entry() {
+    for order in [4, 6] {
+        let fill = Fill::new(&sphere_hole(5, 0.7), &FillOptions { order, ..Default::default() }).unwrap();
+        let p = fill.patch();
+        let us = [0.0, 0.2, 0.5, 0.93, 1.0];
+        let vs: Vec<f64> = (0..23).map(|j| TAU * j as f64 / 23.0 + 0.01).collect();
+        let (values, full) = (p.grid_values(&us, &vs), p.grid(&us, &vs));
+        for (k, (a, b)) in values.iter().zip(&full).enumerate() {
+            // points on the unit sphere's cap: a few roundings of the matrix products
+            assert!((*a - b[0]).norm() < 1e-14, "order {order}, point {k}: {a} vs {}", b[0]);
+        }
+    }
+}

@@ -216,9 +216,11 @@ fn grid_evaluation_matches_pointwise_derivatives() {
         let vs = [dom.at(0.1), dom.at(0.45), dom.at(0.9)];
         let g = p.grid(&us, &vs);
         let g2 = p.grid2(&us, &vs);
+        let values = p.grid_values(&us, &vs);
         for (i, &u) in us.iter().enumerate() {
             for (j, &v) in vs.iter().enumerate() {
                 let d = p.derivatives(u, v, 1, 1);
+                assert!((values[i * vs.len() + j] - d[0]).norm() < 1e-12, "({u}, {v}) value");
                 let want = [d[0], d[2], d[1], d[3]];
                 for k in 0..4 {
                     assert!((g[i * vs.len() + j][k] - want[k]).norm() < 1e-12, "({u}, {v}) entry {k}");
