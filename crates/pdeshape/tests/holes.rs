@@ -291,6 +291,28 @@ fn bad_models_are_refused_with_the_entity_and_line() {
     }
     let many = edited(d, "many.step", "#5 = PRODUCT_DEFINITION('design','',#6,#9);", &text);
     refused(&["holes", &s(&many)], 1, &["many.step:", "places more than 100000 copies"]);
+    // 30 levels of representations each mapping the next twice, with no shell in them:
+    // 2³⁰ mapped items to walk, refused at the cap on the walk's steps
+    let mut text = String::from(
+        "#3 = SHAPE_DEFINITION_REPRESENTATION(#4,#10);\n#7400 = SHAPE_DEFINITION_REPRESENTATION(#4,#7000);\n",
+    );
+    for k in 0..30u64 {
+        text += &format!(
+            "#{} = SHAPE_REPRESENTATION('',(#{},#{}),#97);\n#{} = MAPPED_ITEM('',#{},#11);\n#{} = MAPPED_ITEM('',#{},#11);\n#{} = REPRESENTATION_MAP(#11,#{});\n",
+            7000 + k,
+            7100 + k,
+            7200 + k,
+            7100 + k,
+            7300 + k,
+            7200 + k,
+            7300 + k,
+            7300 + k,
+            7001 + k
+        );
+    }
+    text += "#7030 = SHAPE_REPRESENTATION('',(),#97);";
+    let mapped = edited(d, "mapped.step", "#3 = SHAPE_DEFINITION_REPRESENTATION(#4,#10);", &text);
+    refused(&["holes", &s(&mapped)], 1, &["mapped.step:", "MAPPED_ITEM", "more than 1000000 steps"]);
     // caps
     let cyl = s(&model("cylinder-open.step"));
     refused(&["holes", &cyl, "--limit", "entities=50"], 1, &["entity count", "--limit entities="]);

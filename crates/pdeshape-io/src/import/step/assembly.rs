@@ -23,7 +23,7 @@
 
 use super::{Reader, StepError, collect_refs};
 use pdeshape_core::data::analytic::Frame;
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use step_io::parser::{Attribute, RawEntity};
 
 /// The most copies of shells an assembly may place (a hostile file nesting assemblies
@@ -32,6 +32,10 @@ pub const MAX_INSTANCES: usize = 100_000;
 
 /// Deeper product structures are refused (a cycle of assembly uses is one).
 const MAX_DEPTH: usize = 64;
+
+/// The most products and mapped items the walk visits (each use and mapping counted every
+/// time it is reached): nested uses of many copies each multiply, with or without shells.
+const MAX_VISITS: usize = 1_000_000;
 
 /// One placed copy of a shell.
 #[derive(Clone, Debug, PartialEq)]
@@ -185,7 +189,14 @@ impl<'g> Reader<'g> {
         depth: usize,
         shells: &HashMap<u64, usize>,
         out: &mut Vec<(usize, Frame)>,
+        visits: &mut usize,
     ) -> Result<(), StepError> {
+        *visits += 1;
+        if *visits > MAX_VISITS {
+            return Err(
+                self.err_at(item, format!("the assembly's structure takes more than {MAX_VISITS} steps to walk"))
+            );
+        }
         if let Some(&k) = shells.get(&item) {
             out.push((k, *at));
             return Ok(());
@@ -215,7 +226,7 @@ impl<'g> Reader<'g> {
                 let motion = self.placement(target, item)?.then_in(&self.placement(origin, map)?.inverse());
                 let placed = at.then_in(&motion);
                 for i in self.rep_items(rep) {
-                    self.item_shells(i, &placed, depth + 1, shells, out)?;
+                    self.item_shells(i, &placed, depth + 1, shells, out, visits)?;
                 }
             }
             _ => {}
@@ -301,25 +312,33 @@ impl<'g> Reader<'g> {
             .rev()
             .map(|&pd| (pd, Frame::WORLD, vec![name(pd)]))
             .collect();
+        let mut visits = 0;
         while let Some((pd, at, path)) = todo.pop() {
             if path.len() > MAX_DEPTH {
                 return Err(self.err_at(pd, format!("assemblies nested deeper than {MAX_DEPTH} (a cycle of uses?)")));
+            }
+            visits += 1;
+            if visits > MAX_VISITS {
+                return Err(
+                    self.err_at(pd, format!("the assembly's structure takes more than {MAX_VISITS} steps to walk"))
+                );
             }
             let reps = s.reps(pd);
             let mut placed = Vec::new();
             for &rep in &reps {
                 for item in self.rep_items(rep) {
-                    self.item_shells(item, &at, 0, &shells, &mut placed)?;
+                    self.item_shells(item, &at, 0, &shells, &mut placed, &mut visits)?;
                 }
             }
             // the same shell through two representations of the product (a shape
             // representation and the B-rep's own) is one copy
-            let mut seen: Vec<(usize, Frame)> = Vec::new();
+            let mut seen: HashSet<(usize, [u64; 12])> = HashSet::new();
             for (k, f) in placed {
-                if seen.contains(&(k, f)) {
+                let (o, x, y, z) = (f.o, f.x, f.y, f.z);
+                let key = [o.x, o.y, o.z, x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z].map(f64::to_bits);
+                if !seen.insert((k, key)) {
                     continue;
                 }
-                seen.push((k, f));
                 reached[k] = true;
                 out.push(ShellInstance { shell: k, placement: f, path: path.clone() });
                 if out.len() > MAX_INSTANCES {
