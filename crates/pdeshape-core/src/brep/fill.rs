@@ -134,7 +134,7 @@ pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePie
         out.offset = max_nan(out.offset, foot.max_distance());
         let dir = if tb >= ta { 1.0 } else { -1.0 };
         let side = if f.same_sense { -dir } else { dir };
-        let domain: FieldRef = match FootSeries::new(&foot, &host, (ta, tb), t, series_tolerance(&*curve, (ta, tb))) {
+        let domain: FieldRef = match FootSeries::new(&foot, (ta, tb), series_tolerance(&*curve, (ta, tb))) {
             Some(series) => Arc::new(series),
             None => Arc::new(foot),
         };

@@ -140,6 +140,11 @@ impl FootCurve {
         self.max_distance
     }
 
+    /// The surface's point at domain parameters `c` (at the curve's time).
+    pub fn surface_point(&self, c: [f64; 2]) -> Vec3 {
+        self.host.eval(&[c[0], c[1], self.t])
+    }
+
     /// The foot at `τ`, from the nearest seed.
     pub fn foot(&self, tau: f64) -> Option<[f64; 2]> {
         let (t0, t1) = (self.seeds[0].0, self.seeds[self.seeds.len() - 1].0);

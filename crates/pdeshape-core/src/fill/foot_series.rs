@@ -25,7 +25,7 @@
 
 use super::foot::FootCurve;
 use crate::Vec3;
-use crate::data::{Field, FieldRef, VecJet};
+use crate::data::{Field, VecJet};
 use crate::jet::{Jet, JetShape};
 use crate::num::max_nan;
 
@@ -97,15 +97,15 @@ fn derivative(a: &[f64]) -> Vec<f64> {
 
 impl FootSeries {
     /// Tabulates `foot` over `range` (either order; the foot curve's own range or part of
-    /// it) on the surface `host` (slots `u`, `v`, `t`, at time `t`), halving pieces until
-    /// `|S(c̃) − S(c)| ≤ tol` between the nodes. `None` when a foot is not found or the
-    /// tolerance is not met within [`MAX_DEPTH`] halvings or [`MAX_PIECES`] pieces.
-    pub fn new(foot: &FootCurve, host: &FieldRef, range: (f64, f64), t: f64, tol: f64) -> Option<FootSeries> {
+    /// it), halving pieces until `|S(c̃) − S(c)| ≤ tol` between the nodes (`S` the foot
+    /// curve's surface). `None` when a foot is not found or the tolerance is not met within
+    /// [`MAX_DEPTH`] halvings or [`MAX_PIECES`] pieces.
+    pub fn new(foot: &FootCurve, range: (f64, f64), tol: f64) -> Option<FootSeries> {
         let (lo, hi) = if range.0 <= range.1 { range } else { (range.1, range.0) };
         if !(lo.is_finite() && hi.is_finite() && hi > lo && tol > 0.0) {
             return None;
         }
-        let at = |c: [f64; 2]| host.eval(&[c[0], c[1], t]);
+        let at = |c: [f64; 2]| foot.surface_point(c);
         let mut breaks = vec![lo];
         let mut coeffs = Vec::new();
         let mut max_error: f64 = 0.0;
@@ -232,7 +232,7 @@ impl Field for FootSeries {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::data::ExprField;
+    use crate::data::{ExprField, FieldRef};
     use std::sync::Arc;
 
     /// The helix on a cylinder of radius 2 of the foot curve's own test, whose foot is
@@ -245,7 +245,7 @@ mod tests {
         let curve = Arc::new(ExprField::parse(["2*cos(s*s)", "2*sin(s*s)", "s*s*s"], &["s"], &|_| None).unwrap());
         for range in [(0.5, 1.5), (1.5, 0.5)] {
             let f = FootCurve::new(host.clone(), curve.clone(), range, [0.25, 0.1], 0.0).unwrap();
-            let s = FootSeries::new(&f, &host, range, 0.0, 1e-13).unwrap();
+            let s = FootSeries::new(&f, range, 1e-13).unwrap();
             // τ² and τ³ are polynomials of degree ≤ N: one piece, exact but for round-off
             assert_eq!(s.pieces(), 1);
             assert!(s.max_error() <= 1e-13, "{}", s.max_error());
@@ -277,7 +277,7 @@ mod tests {
         let circle = Arc::new(ExprField::parse(["cos(s)", "sin(s)", "0"], &["s"], &|_| None).unwrap());
         let range = (0.0, 4.7);
         let f = FootCurve::new(plane.clone(), circle, range, [1.0, 0.0], 0.0).unwrap();
-        let s = FootSeries::new(&f, &plane, range, 0.0, 1e-13).unwrap();
+        let s = FootSeries::new(&f, range, 1e-13).unwrap();
         for tau in [0.1, 1.234, 3.3, 4.69] {
             let d = s.derivatives(tau, 2);
             // one piece of degree 20 over 4.7 rad: seen 1.2e-15 (values), 2e-14 (first
@@ -288,7 +288,7 @@ mod tests {
         }
         let kink = Arc::new(ExprField::parse(["s", "abs(s - 0.3)^3", "0"], &["s"], &|_| None).unwrap());
         let f = FootCurve::new(plane.clone(), kink, (0.0, 1.0), [0.0, 0.0], 0.0).unwrap();
-        let s = FootSeries::new(&f, &plane, (0.0, 1.0), 0.0, 1e-13).unwrap();
+        let s = FootSeries::new(&f, (0.0, 1.0), 1e-13).unwrap();
         // seen: 11 pieces, 1.0e-14
         assert!(s.pieces() > 4, "{} pieces", s.pieces());
         assert!(s.max_error() <= 1e-13, "{}", s.max_error());
@@ -300,6 +300,6 @@ mod tests {
         // keeps the exact foot curve
         let corner = Arc::new(ExprField::parse(["s", "abs(s - 0.3)", "0"], &["s"], &|_| None).unwrap());
         let f = FootCurve::new(plane.clone(), corner, (0.0, 1.0), [0.0, 0.0], 0.0).unwrap();
-        assert!(FootSeries::new(&f, &plane, (0.0, 1.0), 0.0, 1e-13).is_none());
+        assert!(FootSeries::new(&f, (0.0, 1.0), 1e-13).is_none());
     }
 }

@@ -313,6 +313,10 @@ impl<'g> Reader<'g> {
             .map(|&pd| (pd, Frame::WORLD, vec![name(pd)]))
             .collect();
         let mut visits = 0;
+        // each product's representations, found once (a part used many times is reached
+        // as often)
+        let mut reps_of: HashMap<u64, BTreeSet<u64>> = HashMap::new();
+        let mut reps = |pd: u64| reps_of.entry(pd).or_insert_with(|| s.reps(pd)).clone();
         while let Some((pd, at, path)) = todo.pop() {
             if path.len() > MAX_DEPTH {
                 return Err(self.err_at(pd, format!("assemblies nested deeper than {MAX_DEPTH} (a cycle of uses?)")));
@@ -323,9 +327,8 @@ impl<'g> Reader<'g> {
                     self.err_at(pd, format!("the assembly's structure takes more than {MAX_VISITS} steps to walk"))
                 );
             }
-            let reps = s.reps(pd);
             let mut placed = Vec::new();
-            for &rep in &reps {
+            for rep in reps(pd) {
                 for item in self.rep_items(rep) {
                     self.item_shells(item, &at, 0, &shells, &mut placed, &mut visits)?;
                 }
@@ -348,7 +351,7 @@ impl<'g> Reader<'g> {
                 }
             }
             for &(use_id, child) in by_parent.get(&pd).into_iter().flatten().rev() {
-                let child_reps = s.reps(child);
+                let child_reps = reps(child);
                 let mut motion = None;
                 for &shape in s.shape_of.get(&use_id).into_iter().flatten() {
                     if let Some(m) = self.use_motion(&s, shape, &child_reps)? {
