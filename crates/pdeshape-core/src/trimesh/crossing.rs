@@ -113,6 +113,46 @@ pub fn crossings(m: &TriMesh, first_new: usize, limit: usize) -> Vec<(usize, usi
     out
 }
 
+/// Whether the new triangles `triangles` (on `m`'s vertices and on `positions`, numbered
+/// from `base`) cross none of `m`'s triangles and none of each other: [`crossings`] on a
+/// local mesh of the new triangles and the input triangles whose boxes meet theirs.
+pub(super) fn crossing_free(m: &TriMesh, positions: &[Vec3], triangles: &[[u32; 3]], base: u32) -> bool {
+    let at = |i: u32| if i < base { m.positions[i as usize] } else { positions[(i - base) as usize] };
+    let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    for t in triangles {
+        for &i in t {
+            lo = lo.min(at(i));
+            hi = hi.max(at(i));
+        }
+    }
+    let pad = TOL * (hi - lo).max_abs();
+    let (lo, hi) = (lo - Vec3::new(pad, pad, pad), hi + Vec3::new(pad, pad, pad));
+    let near = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        let (l, h) = (a.min(b).min(c), a.max(b).max(c));
+        (0..3).all(|k| h[k] >= lo[k] && l[k] <= hi[k])
+    };
+    let mut local = TriMesh::default();
+    let mut index: HashMap<u32, u32> = HashMap::new();
+    let mut map = |i: u32, local: &mut TriMesh| {
+        *index.entry(i).or_insert_with(|| {
+            local.positions.push(at(i));
+            local.positions.len() as u32 - 1
+        })
+    };
+    for t in m.triangles.iter().filter(|t| near(t)) {
+        let tri = t.map(|i| map(i, &mut local));
+        local.triangles.push(tri);
+    }
+    let first = local.triangles.len();
+    for t in triangles {
+        let tri = t.map(|i| map(i, &mut local));
+        local.triangles.push(tri);
+    }
+    crossings(&local, first, 1).is_empty()
+}
+
 /// Whether triangles `a` and `b`, which share `shared` vertices (by index), cross (see the
 /// module's documentation).
 pub fn triangles_cross(a: [Vec3; 3], b: [Vec3; 3], shared: usize) -> bool {

@@ -4,28 +4,39 @@
 //!
 //! **The fill.** A hole's loop zigzags along the mesh's edges; a fill forced through such
 //! a loop would carry the zigzag into its boundary layer. The fill is therefore bounded by
-//! the collar's isoline `s = s_c`, a smooth curve just inside the hole
-//! (`s_c = min_i s_i − h/2`, `s_i` the loop vertices' own `s`), cut into four pieces of
-//! equal `w`-length; its cross tangent points to `−C_s`, away from the mesh, and it meets
-//! the collar G1 (order 4) or G2 (order 6) along that curve by construction. Its boundary
-//! is `X(0, v) = C(s_c, w₀ + L v / 2π)`.
+//! a smooth curve `s = σ̄(w)` in the collar's domain just inside the hole (a spline on the
+//! spine's breakpoints fitted to `s_i − 0.87 h` at the loop's vertices, lowered as a whole
+//! to stay `0.4 h` beyond every loop vertex and `0.25 h` beyond every band vertex), cut
+//! into four pieces of equal `w`-length; its cross tangent points away from the mesh, and
+//! it meets the collar G1 (order 4) or G2 (order 6) along that curve by construction.
 //!
 //! **The band.** Between the loop and the fill's boundary lies a band of the collar
-//! itself, at most about one edge wide: the loop's vertices (at `v_i = 2π (w_i − w₀) / L`)
-//! are zipped to the fill boundary's vertices. The mesh's loop vertices lie on the
-//! collar up to its fit residual (reported), the fill's vertices on the fill.
+//! itself, about one edge wide. Its triangles on the loop's edges have their apexes over
+//! the edges ([`super::band`]), so that they crease against the mesh's triangles no more
+//! than the mesh's own do; the ring of those apexes is zipped to the fill's boundary.
+//! Where that band cannot be built, or its mesh would cross the input, the loop's own
+//! vertices are zipped to the fill's boundary (at their mid-`v`: a strip of quads). The
+//! mesh's loop vertices lie on the collar up to its fit residual (reported), the band's
+//! vertices on the collar, the fill's on the fill.
 //!
 //! **The mesh.** `h`, the median length of the mesh's edges at the loop's vertices, sets
-//! the density: the fill's boundary gets `round(length / h)` vertices, then rings
-//! `u = u_j` at equal steps of the mean arc length from the boundary to the pole,
-//! `round(ℓ / h)` of them, each with `round(perimeter / h)` vertices (at least 3) at
-//! equal steps of `v`, staggered from ring to ring, and the pole. Neighbouring rings are
+//! the density: rings `u = u_j` at equal steps of the mean arc length from the boundary to
+//! the pole, `round(ℓ / h)` of them, each with `round(perimeter / h)` vertices (at least
+//! 3) at equal steps of `v`, staggered from ring to ring, and the pole; on the boundary
+//! ring, a vertex within `0.4 h` of a band vertex is left out. Neighbouring rings are
 //! zipped by increasing `v` (the next triangle takes whichever ring's next vertex comes
 //! first). Every triangle is clockwise in the `(v, u)` chart, which makes it run each loop
 //! edge against the way the mesh runs it: the output is consistently oriented, and each
-//! loop edge ends up in exactly two triangles.
+//! loop edge ends up in exactly two triangles. Last, the new triangles' edges are flipped
+//! towards Delaunay ([`super::flip`]), those on the loop's edges kept as placed.
+//!
+//! **Crossings.** The first of (band, flipped), (loop zipped, flipped), (loop zipped) whose
+//! triangles cross neither the input's nor each other ([`super::crossing`]) is taken.
 
+use super::band::{Band, BandInput, BandVertex, apex_band};
 use super::collar::{CollarError, CollarFit, DomainLine, adjacency, fit_collar, triangles_on_loop};
+use super::crossing::crossing_free;
+use super::flip::flip_to_delaunay;
 use super::{LoopKind, MeshLoop, TriMesh};
 use crate::Vec3;
 use crate::data::FieldRef;
@@ -144,7 +155,11 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     let adj = adjacency(m);
     let fit = fit_collar(m, &adj, lp, o.rings)?;
     let (period, w0) = (fit.period, fit.params[0].1);
-    let line = boundary_line(&fit, h);
+    let loop_pos: Vec<Vec3> = lp.vertices.iter().map(|&v| m.positions[v as usize]).collect();
+    let band_input =
+        BandInput { ids: &lp.vertices, pos: &loop_pos, params: &fit.params, collar: &fit.collar, period, h };
+    let band = apex_band(&band_input, base);
+    let line = boundary_line(&fit, h, band.as_ref().map_or(&[][..], |b| &b.vertices));
     let along = AlongCurve {
         host: Host::Field(Arc::new(fit.collar.clone())),
         curve: DomainCurve::Field(Arc::new(line.clone())),
@@ -204,54 +219,143 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         let t = if a1 > a0 { (target - a0) / (a1 - a0) } else { 0.0 };
         us[i - 1] + t * (us[i] - us[i - 1])
     };
-    let mut positions = Vec::new();
-    // chart heights: −s in the band (scaled like v), then the fill's u above it
-    let y_of_s = |s: f64| -TAU * s / period;
-    let s_top = fit.params.iter().fold(f64::INFINITY, |a, p| a.min(p.0)) - 2.0 * h;
-    let lp_ring: Vec<(f64, f64, u32)> =
-        fit.params.iter().zip(&lp.vertices).map(|(&(s, w), &v)| (TAU * (w - w0) / period, y_of_s(s), v)).collect();
-    let mut triangles = ears;
-    let mut ring_prev = Vec::new();
+    // the rings from the fill's boundary (ring 0, its `v` set by the ring below it) to the
+    // pole: (u, vertices)
+    let mut plan = Vec::with_capacity(rings);
+    // ring 0 and the band have fewer than 2 vertices a loop vertex
+    let mut count = 2.0 * n as f64;
     for j in 0..rings {
         let u = if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) };
         let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
         let pts = patch.grid(&[u], &around);
         let perim: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).norm()).sum();
         let nj_f = (perim / h).round();
-        if nj_f.is_nan() || nj_f + positions.len() as f64 > o.max_vertices as f64 {
+        if j > 0 {
+            count += nj_f;
+        }
+        if nj_f.is_nan() || count > o.max_vertices as f64 {
             return Err(too_many());
         }
-        let nj = (nj_f as usize).max(3);
-        let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
-        // the fill's boundary gets the loop's own v: the band is a strip of quads
-        let ring_v: Vec<f64> = if j == 0 {
-            let nl = lp_ring.len();
-            (0..nl).map(|i| 0.5 * (lp_ring[i].0 + if i + 1 < nl { lp_ring[i + 1].0 } else { TAU })).collect()
-        } else {
-            (0..nj).map(|k| TAU * (k as f64 + shift) / nj as f64).collect()
-        };
-        let pts = patch.grid(&[u], &ring_v);
-        let ring: Vec<(f64, f64, u32)> = ring_v
-            .into_iter()
-            .zip(pts)
-            .map(|(v, p)| {
-                positions.push(p[0]);
-                let y = if j == 0 { y_of_s(line.sigma(w0 + period * v / TAU)) } else { y_of_s(s_top) + u };
-                (v, y, base + positions.len() as u32 - 1)
-            })
-            .collect();
-        let at = |i: u32| {
-            if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
-        };
-        zip(if j == 0 { &lp_ring } else { &ring_prev }, &ring, &at, &mut triangles);
-        ring_prev = ring;
+        plan.push((u, (nj_f as usize).max(3)));
     }
-    positions.push(patch.point(1.0, 0.0));
-    let pole = base + positions.len() as u32 - 1;
-    let np = ring_prev.len();
-    for i in 0..np {
-        triangles.push([ring_prev[(i + 1) % np].2, ring_prev[i].2, pole]);
+    // chart heights: −s in the band (scaled like v), then the fill's u above it
+    let y_of_s = |s: f64| -TAU * s / period;
+    let v_of_w = |w: f64| TAU * (w - w0).rem_euclid(period) / period;
+    let s_top = fit.params.iter().fold(f64::INFINITY, |a, p| a.min(p.0)) - 2.0 * h;
+    let lp_ring: Vec<(f64, f64, u32)> =
+        fit.params.iter().zip(&lp.vertices).map(|(&(s, w), &v)| (TAU * (w - w0) / period, y_of_s(s), v)).collect();
+    // the new triangles on the loop's edges (and the ears' on the input loop's) keep their
+    // shape through the flips
+    let on_seam: std::collections::HashSet<(u32, u32)> = [&original.1.vertices, &lp.vertices]
+        .into_iter()
+        .flat_map(|l| (0..l.len()).map(move |i| (l[(i + 1) % l.len()], l[i])))
+        .collect();
+    // the mesh of the band (or, without one, the loop zipped to the fill's boundary), the
+    // rings and the pole, its edges flipped towards Delaunay when asked
+    let build = |band: Option<&Band>, flips: bool| -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
+        let mut positions = Vec::new();
+        let mut triangles = ears.clone();
+        let mut ring_prev = match band {
+            Some(b) => {
+                positions.extend(b.vertices.iter().map(|v| v.p));
+                triangles.extend(&b.triangles);
+                let mut ring: Vec<(f64, f64, u32)> =
+                    b.vertices.iter().enumerate().map(|(k, v)| (v_of_w(v.w), y_of_s(v.s), base + k as u32)).collect();
+                let first = (0..ring.len()).min_by(|&a, &b| ring[a].0.total_cmp(&ring[b].0))?;
+                ring.rotate_left(first);
+                // the band's vertices must follow each other around the collar
+                if !ring.windows(2).all(|w| w[0].0 < w[1].0) {
+                    return None;
+                }
+                ring
+            }
+            None => lp_ring.clone(),
+        };
+        let band_pos: Vec<Vec3> = band.map_or(Vec::new(), |b| b.vertices.iter().map(|v| v.p).collect());
+        let at_band = |i: u32| {
+            if (i as usize) < m.positions.len() { m.positions[i as usize] } else { band_pos[(i - base) as usize] }
+        };
+        for (j, &(u, nj)) in plan.iter().enumerate() {
+            let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
+            // the fill's boundary over the loop gets the loop's mid-`v`: a strip of quads
+            let ring_v: Vec<f64> = if j == 0 && band.is_some() {
+                // the band's vertices are spaced unevenly (splits, merges): evenly spaced
+                (0..nj).map(|k| TAU * (k as f64 + 0.5) / nj as f64).collect()
+            } else if j == 0 {
+                let nl = ring_prev.len();
+                (0..nl).map(|i| 0.5 * (ring_prev[i].0 + if i + 1 < nl { ring_prev[i + 1].0 } else { TAU })).collect()
+            } else {
+                (0..nj).map(|k| TAU * (k as f64 + shift) / nj as f64).collect()
+            };
+            let mut pts = patch.grid(&[u], &ring_v);
+            let mut ring_v = ring_v;
+            if j == 0 && band.is_some() {
+                // a boundary vertex within 0.4 h of a band vertex is left out (never three
+                // neighbours): the band's vertices lie unevenly close to the boundary
+                let near = |p: Vec3| ring_prev.iter().any(|r| (at_band(r.2) - p).norm() < 0.4 * h);
+                let mut keep = vec![true; pts.len()];
+                for k in 0..pts.len() {
+                    let prev_dropped = k > 1 && !keep[k - 1] && !keep[k - 2];
+                    if !prev_dropped && near(pts[k][0]) && keep.iter().filter(|x| **x).count() > 3 {
+                        keep[k] = false;
+                    }
+                }
+                if !keep[0] && !keep[pts.len() - 1] {
+                    keep[0] = true;
+                }
+                let mut it = keep.iter();
+                pts.retain(|_| *it.next().unwrap_or(&true));
+                let mut it = keep.iter();
+                ring_v.retain(|_| *it.next().unwrap_or(&true));
+            }
+            let ring: Vec<(f64, f64, u32)> = ring_v
+                .into_iter()
+                .zip(pts)
+                .map(|(v, p)| {
+                    positions.push(p[0]);
+                    let y = if j == 0 { y_of_s(line.sigma(w0 + period * v / TAU)) } else { y_of_s(s_top) + u };
+                    (v, y, base + positions.len() as u32 - 1)
+                })
+                .collect();
+            let at = |i: u32| {
+                if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
+            };
+            zip(&ring_prev, &ring, &at, &mut triangles);
+            ring_prev = ring;
+        }
+        positions.push(patch.point(1.0, 0.0));
+        let pole = base + positions.len() as u32 - 1;
+        let np = ring_prev.len();
+        for i in 0..np {
+            triangles.push([ring_prev[(i + 1) % np].2, ring_prev[i].2, pole]);
+        }
+        if flips {
+            let at = |i: u32| {
+                if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
+            };
+            let exists = |a: u32, b: u32| a < base && b < base && adj[a as usize].binary_search(&b).is_ok();
+            let budget = 8 * triangles.len();
+            let frozen = |t: &[u32; 3]| (0..3).any(|k| on_seam.contains(&(t[k], t[(k + 1) % 3])));
+            flip_to_delaunay(&mut triangles, &at, &exists, &frozen, budget);
+        }
+        Some((positions, triangles))
+    };
+    // the band over the loop's edges, flipped; else the loop zipped to the fill's
+    // boundary, flipped; else that unflipped: the first whose triangles cross nothing
+    let tries = [(band.as_ref(), true), (None, true), (None, false)];
+    let mut made = None;
+    for (k, &(b, flips)) in tries.iter().enumerate() {
+        if b.is_none() && k == 0 {
+            continue;
+        }
+        let Some(mesh) = build(b, flips) else { continue };
+        let last = k + 1 == tries.len();
+        if last || crossing_free(original.0, &mesh.0, &mesh.1, base) {
+            made = Some(mesh);
+            break;
+        }
     }
+    let (positions, triangles) = made.ok_or(LoopFillError::Crease)?;
     // measures: the seam's dihedral angles and the new edges' lengths
     let at = |i: u32| {
         if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
@@ -294,18 +398,23 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     })
 }
 
+/// The least room (in `h`) between a band vertex and the fill's boundary.
+const BAND_CLEAR: f64 = 0.25;
+
 /// The fill's boundary in the collar's domain: `σ̄`, a spline on the spine's breakpoints
 /// fitted to `s_i − 0.87 h` at the loop's vertices (the height of an equilateral triangle
-/// on a loop edge), lowered where it comes within `0.4 h` of a vertex's `s_i`.
-fn boundary_line(fit: &CollarFit, h: f64) -> DomainLine {
+/// on a loop edge), lowered where it comes within `0.4 h` of a vertex's `s_i` or within
+/// `0.25 h` of a band vertex's `s`.
+fn boundary_line(fit: &CollarFit, h: f64, band: &[BandVertex]) -> DomainLine {
     let b = &fit.spine_basis;
     let nc = b.len();
     let mut g = faer::Mat::<f64>::zeros(nc, nc);
     let mut r = faer::Mat::<f64>::zeros(nc, 1);
     for &(s, w) in &fit.params {
+        let s = s - 0.87 * h;
         let (j0, bas) = b.basis(w, 0);
         for p in 0..4 {
-            r[((j0 + p) % nc, 0)] += bas[0][p] * (s - 0.87 * h);
+            r[((j0 + p) % nc, 0)] += bas[0][p] * s;
             for q in 0..4 {
                 g[((j0 + p) % nc, (j0 + q) % nc)] += bas[0][p] * bas[0][q];
             }
@@ -317,7 +426,8 @@ fn boundary_line(fit: &CollarFit, h: f64) -> DomainLine {
     let sol = g.full_piv_lu().solve(&r);
     let mut ctrl: Vec<f64> = (0..nc).map(|i| sol[(i, 0)]).collect();
     let line = DomainLine::new(b, &ctrl);
-    let over = fit.params.iter().fold(f64::NEG_INFINITY, |a, &(s, w)| a.max(line.sigma(w) - (s - 0.4 * h)));
+    let over = fit.params.iter().fold(f64::NEG_INFINITY, |a, &(s, w)| max_nan(a, line.sigma(w) - (s - 0.4 * h)));
+    let over = band.iter().fold(over, |a, b| max_nan(a, line.sigma(b.w) - (b.s - BAND_CLEAR * h)));
     if over > 0.0 {
         // a spline's values shift with its control points (partition of unity)
         ctrl.iter_mut().for_each(|c| *c -= over);

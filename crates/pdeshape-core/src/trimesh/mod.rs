@@ -6,12 +6,15 @@
 //! ([`MeshLoop`]). [`fill_loop`] fills a simple loop by a fill of order 4 (G1) or 6 (G2):
 //! the surface around the loop is estimated by a [`Collar`] fitted to the vertices within
 //! a few rings of it, the fill meets the collar G1/G2 along the loop, and the fill is
-//! meshed at the density of the mesh around it and stitched to the loop's own vertices.
+//! meshed at the density of the mesh around it and stitched to the loop's own vertices
+//! through a band whose triangles on the loop's edges are shaped like the mesh's own.
 //! [`crossings`] checks that no new triangle crosses another.
 
+mod band;
 mod collar;
 mod crossing;
 mod fill;
+mod flip;
 mod loops;
 mod periodic;
 pub mod shapes;

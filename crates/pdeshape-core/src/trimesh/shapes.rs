@@ -104,3 +104,34 @@ pub fn height_grid(k: usize, r: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh {
     }
     TriMesh { positions, triangles }
 }
+
+/// The torus `((R + r cos φ) cos θ, (R + r cos φ) sin θ, r sin φ)` on an `nu × nv` grid of
+/// quads, each split along one diagonal (the first halves, then the second), outward-facing,
+/// without the triangles whose
+/// centroid lies within `cut` of `hole`.
+pub fn torus(nu: usize, nv: usize, big: f64, small: f64, hole: Vec3, cut: f64) -> TriMesh {
+    use std::f64::consts::TAU;
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (th, ph) = (TAU * i as f64 / nu as f64, TAU * j as f64 / nv as f64);
+            let rr = big + small * ph.cos();
+            positions.push(Vec3::new(rr * th.cos(), rr * th.sin(), small * ph.sin()));
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + j % nv) as u32;
+    let mut triangles = Vec::with_capacity(2 * nu * nv);
+    for half in 0..2 {
+        for i in 0..nu {
+            for j in 0..nv {
+                let (a, b, c, d) = (id(i, j), id(i, j + 1), id(i + 1, j), id(i + 1, j + 1));
+                let t = if half == 0 { [a, c, d] } else { [a, d, b] };
+                let centroid = t.iter().fold(Vec3::ZERO, |s, &v| s + positions[v as usize]) * (1.0 / 3.0);
+                if (centroid - hole).norm() > cut {
+                    triangles.push(t);
+                }
+            }
+        }
+    }
+    TriMesh { positions, triangles }
+}

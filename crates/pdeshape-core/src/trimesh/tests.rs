@@ -29,7 +29,7 @@ fn sphere_cap_filled() {
         assert!(boundary(&closed).unwrap().is_empty(), "order {order}: the hole is closed, orientation consistent");
         let off = f.positions.iter().fold(0.0, |a: f64, p| max_nan(a, (p.norm() - 1.0).abs()));
         eprintln!(
-            "order {order}: collar rms {:.2e} max {:.2e} loop {:.2e} cond {:.1e}; G1 {:.2e} gap {:.2e} G2 {:.2e}; off sphere {off:.2e}; seam {:.3} (p99 {p99:.3}); edges {:.2}–{:.2} h; {} new vertices",
+            "order {order}: collar rms {:.2e} max {:.2e} loop {:.2e} cond {:.1e}; G1 {:.2e} gap {:.2e} G2 {:.2e}; off sphere {off:.2e}; seam {:.5} (p99 {p99:.5}); edges {:.2}–{:.2} h; {} new vertices",
             f.fit.rms,
             f.fit.max_residual,
             f.fit.loop_residual,
@@ -50,16 +50,99 @@ fn sphere_cap_filled() {
         }
         // the loop vertices lie on the collar up to its fit residual
         assert!(f.fit.loop_residual < 2e-3, "{}", f.fit.loop_residual);
-        // a uniform icosphere's dihedral angles all lie near 0.047: its 99th percentile is
-        // its typical angle, and the band's triangles (right, not equilateral) tilt up to
-        // 0.04 from the sphere's normal where the mesh's tilt 0.025
-        assert!(f.seam_dihedral <= 1.4 * p99, "{} > 1.4 × {p99}", f.seam_dihedral);
+        // no seam: a uniform icosphere's dihedral angles all lie near its 99th percentile,
+        // and the new triangles on the loop's edges crease against the mesh's no more than
+        // its own do (their apexes over the edges, see `band`): 0.05010 against 0.05021
+        // seen, 0.0646 before the band's apexes were placed over the edges
+        assert!(f.seam_dihedral <= p99, "{} > {p99}", f.seam_dihedral);
         assert!(f.edge_ratio.0 > 0.3 && f.edge_ratio.1 < 2.0, "{:?}", f.edge_ratio);
         // the fairest fill (least Willmore energy; the sphere is a critical point of it)
-        // lies within twice the collar's own fit residual (5.9e-4) of the sphere: 1.1e-3
-        // seen (the fill of fullness and height 1, before the choice, lay 5.7e-3 off)
+        // lies within three times the collar's own fit residual (5.9e-4) of the sphere:
+        // 1.3e-3 seen (the fill of fullness and height 1, before the choice, lay 5.7e-3 off)
         assert!(off < 1.5e-3, "{off}");
     }
+}
+
+/// A hole in a torus of quads split along a diagonal, where the loop is a staircase of
+/// steep and shallow edges: filled at order 6 with no seam (the largest dihedral angle at
+/// the loop's edges at most the mesh's 99th percentile: 0.0982 against 0.0982 seen, 0.247
+/// before the band's apexes were placed over the edges), closed, the new edges within
+/// 0.3–2 times the median edge at the loop (0.30–1.91 seen).
+#[test]
+fn torus_hole_without_seam() {
+    use super::shapes::torus;
+    let m = torus(128, 64, 1.0, 0.4, Vec3::new(1.0, 0.0, 0.4), 0.3);
+    let loops = boundary(&m).unwrap();
+    assert_eq!(loops.len(), 1);
+    let own: Vec<f64> = dihedral_angles(&m).iter().map(|e| e.1).collect();
+    let p99 = quantile(&own, 0.99);
+    let f = fill_loop(&m, &loops[0], m.positions.len() as u32, &LoopFillOptions { order: 6, ..Default::default() })
+        .unwrap();
+    assert!(boundary(&stitched(&m, &f)).unwrap().is_empty());
+    let off = f.positions.iter().fold(0.0, |a: f64, p| {
+        let ring = (p.x.hypot(p.y) - 1.0).hypot(p.z);
+        max_nan(a, (ring - 0.4).abs())
+    });
+    eprintln!(
+        "seam {:.5} (p99 {p99:.5}); edges {:.2}–{:.2} h; off the torus {off:.2e}",
+        f.seam_dihedral, f.edge_ratio.0, f.edge_ratio.1
+    );
+    assert!(f.seam_dihedral <= p99, "{} > {p99}", f.seam_dihedral);
+    assert!(f.edge_ratio.0 > 0.29 && f.edge_ratio.1 < 2.0, "{:?}", f.edge_ratio);
+    assert!(f.continuity.g2 < 1e-7, "{}", f.continuity.g2);
+    // the fill's vertices near the torus (the hole is 0.6 across where the tube's radius
+    // is 0.4): 2.9e-3 seen
+    assert!(off < 6e-3, "{off}");
+}
+
+/// A round hole in a flat grid: the collar is the plane, so the fill and the band lie in
+/// it to round-off and every new triangle faces up; the band's single apexes stand over
+/// their edges' midpoints at 0.55 of the edge's length (the Newton solve on the collar to
+/// round-off), and the seam is flat.
+#[test]
+fn band_apexes_stand_over_the_edges() {
+    let m = height_grid(40, 0.45, |_, _| 0.0);
+    let loops = boundary(&m).unwrap();
+    let hole = loops.iter().find(|l| l.kind == LoopKind::Hole).unwrap();
+    let base = m.positions.len() as u32;
+    let f = fill_loop(&m, hole, base, &LoopFillOptions::default()).unwrap();
+    let at = |i: u32| if i < base { m.positions[i as usize] } else { f.positions[(i - base) as usize] };
+    // coordinates of size 1 through a least-squares collar and a fill solve: 1e-12
+    for p in &f.positions {
+        assert!(p.z.abs() < 1e-12, "{p:?}");
+    }
+    for t in &f.triangles {
+        let [a, b, c] = t.map(at);
+        let n = (b - a).cross(c - a);
+        assert!(n.z > 0.0 && n.z > 0.9 * n.norm(), "{t:?} {n:?}");
+    }
+    // new triangles on the loop's edges, (x_{i+1}, x_i, apex): along and height in edge lengths
+    let n = hole.vertices.len();
+    let mut single = 0;
+    for i in 0..n {
+        let (v0, v1) = (hole.vertices[i], hole.vertices[(i + 1) % n]);
+        let Some(t) = f.triangles.iter().find(|t| (0..3).any(|k| t[k] == v1 && t[(k + 1) % 3] == v0)) else {
+            panic!("loop edge {i} is not closed");
+        };
+        let apex = t.iter().copied().find(|&v| v != v0 && v != v1).unwrap();
+        if apex < base {
+            continue; // an ear
+        }
+        let (p0, p1) = (at(v0), at(v1));
+        let l = (p1 - p0).norm();
+        let d = at(apex) - (p0 + p1) * 0.5;
+        let (along, height) = (d.dot(p1 - p0) / (l * l), (d - (p1 - p0) * (d.dot(p1 - p0) / (l * l))).norm() / l);
+        if along.abs() < 1e-9 {
+            // the Newton solve's residual is ~1e-13 of the coordinates
+            assert!((height - 0.55).abs() < 1e-9, "edge {i}: height {height}");
+            single += 1;
+        }
+    }
+    // the grid's staircase loop has many notches (edges sharing an apex) and ears: 20 of
+    // 70 edges seen with their own apex (none when the band falls back to the zipped loop)
+    assert!(single >= n / 5, "{single} of {n} edges have their own apex");
+    // the seam: the plane's triangles meet the band's at no angle
+    assert!(f.seam_dihedral < 1e-9, "{}", f.seam_dihedral);
 }
 
 /// A fill whose mesh would pass the vertex cap is refused before it is built (a loop long
