@@ -202,6 +202,37 @@ def measure(v0, f0, v, f, dist):
     return len(new), d.max(), math.sqrt((d * d).mean()), seam, own, n0
 
 
+def bench_models():
+    """The bench's meshes: (name, vertices, faces, distance to the true surface, --max-edges)."""
+    sph_v, sph_f = icosphere(5)
+    caps = [((0.3, 0.2, 0.9), 35), ((-0.7, 0.6, -0.2), 25), ((0.1, -0.8, -0.5), 18)]
+
+    def sphere_keep(c):
+        k = np.ones(len(c), bool)
+        for d, a in caps:
+            d = np.array(d) / np.linalg.norm(d)
+            k &= (c / np.linalg.norm(c, axis=1)[:, None]) @ d < math.cos(math.radians(a))
+        return k
+
+    tor_v, tor_f = torus()
+
+    def torus_keep(c):
+        k = np.ones(len(c), bool)
+        for p in ([1.0, 0.0, 0.4], [-0.6, 0.8 * 1.4 / 1.0, 0.0]):
+            k &= np.linalg.norm(c - np.array(p), axis=1) > 0.3
+        return k
+
+    fld_v, fld_f = field()
+    return [
+        ("sphere, 3 caps (35°, 25°, 18°)", *cut(sph_v, sph_f, sphere_keep),
+         lambda p: np.abs(np.linalg.norm(p, axis=1) - 1.0), None),
+        ("torus, 2 holes", *cut(tor_v, tor_f, torus_keep),
+         lambda p: np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4), None),
+        ("height field, elliptical hole", *cut(fld_v, fld_f, lambda c: (c[:, 0] / 0.45) ** 2 + (c[:, 1] / 0.3) ** 2 >= 1),
+         lambda p: np.abs(p[:, 2] - height(p[:, 0], p[:, 1])), "200"),
+    ]
+
+
 # camera (azimuth, elevation) looking into each model's first hole
 VIEWS = [(33.7, 68.5), (0.0, 50.0), (35.0, 55.0)]
 
@@ -242,33 +273,7 @@ def main():
     shots = []
     if not EXE.exists():
         sys.exit(f"build {EXE} first: cargo build --release")
-    sph_v, sph_f = icosphere(5)
-    caps = [((0.3, 0.2, 0.9), 35), ((-0.7, 0.6, -0.2), 25), ((0.1, -0.8, -0.5), 18)]
-
-    def sphere_keep(c):
-        k = np.ones(len(c), bool)
-        for d, a in caps:
-            d = np.array(d) / np.linalg.norm(d)
-            k &= (c / np.linalg.norm(c, axis=1)[:, None]) @ d < math.cos(math.radians(a))
-        return k
-
-    tor_v, tor_f = torus()
-
-    def torus_keep(c):
-        k = np.ones(len(c), bool)
-        for p in ([1.0, 0.0, 0.4], [-0.6, 0.8 * 1.4 / 1.0, 0.0]):
-            k &= np.linalg.norm(c - np.array(p), axis=1) > 0.3
-        return k
-
-    fld_v, fld_f = field()
-    models = [
-        ("sphere, 3 caps (35°, 25°, 18°)", *cut(sph_v, sph_f, sphere_keep),
-         lambda p: np.abs(np.linalg.norm(p, axis=1) - 1.0), None),
-        ("torus, 2 holes", *cut(tor_v, tor_f, torus_keep),
-         lambda p: np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4), None),
-        ("height field, elliptical hole", *cut(fld_v, fld_f, lambda c: (c[:, 0] / 0.45) ** 2 + (c[:, 1] / 0.3) ** 2 >= 1),
-         lambda p: np.abs(p[:, 2] - height(p[:, 0], p[:, 1])), "200"),
-    ]
+    models = bench_models()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, v, f, dist, max_edges in models:

@@ -23,35 +23,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cgal_mesh_holes as bench  # noqa: E402
 
 
-def models():
-    sph_v, sph_f = bench.icosphere(5)
-    caps = [((0.3, 0.2, 0.9), 35), ((-0.7, 0.6, -0.2), 25), ((0.1, -0.8, -0.5), 18)]
-
-    def sphere_keep(c):
-        k = np.ones(len(c), bool)
-        for d, a in caps:
-            d = np.array(d) / np.linalg.norm(d)
-            k &= (c / np.linalg.norm(c, axis=1)[:, None]) @ d < np.cos(np.radians(a))
-        return k
-
-    tor_v, tor_f = bench.torus()
-
-    def torus_keep(c):
-        k = np.ones(len(c), bool)
-        for p in ([1.0, 0.0, 0.4], [-0.6, 0.8 * 1.4 / 1.0, 0.0]):
-            k &= np.linalg.norm(c - np.array(p), axis=1) > 0.3
-        return k
-
-    fld_v, fld_f = bench.field()
-    return [
-        ("sphere", *bench.cut(sph_v, sph_f, sphere_keep), lambda p: np.abs(np.linalg.norm(p, axis=1) - 1.0), None),
-        ("torus", *bench.cut(tor_v, tor_f, torus_keep),
-         lambda p: np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4), None),
-        ("height field", *bench.cut(fld_v, fld_f, lambda c: (c[:, 0] / 0.45) ** 2 + (c[:, 1] / 0.3) ** 2 >= 1),
-         lambda p: np.abs(p[:, 2] - bench.height(p[:, 0], p[:, 1])), "200"),
-    ]
-
-
 def diagnose(v0, f0, v, f, dist):
     n0 = len(v0)
     # fill-holes appends: input vertices keep their indices
@@ -77,7 +48,7 @@ def main():
     print("| mesh | binary | largest distance | seam | edges over p99 | p99 | inner max | new edge min/max (h) |")
     print("|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
-        for name, v, f, dist, max_edges in models():
+        for name, v, f, dist, max_edges in bench.bench_models():
             obj = Path(tmp) / "in.obj"
             bench.write_obj(obj, v, f)
             for exe in exes:
