@@ -57,9 +57,11 @@ fn sphere_cap_filled() {
         assert!(f.seam_dihedral <= p99, "{} > {p99}", f.seam_dihedral);
         assert!(f.edge_ratio.0 > 0.3 && f.edge_ratio.1 < 2.0, "{:?}", f.edge_ratio);
         // the fairest fill (least Willmore energy; the sphere is a critical point of it)
-        // lies within three times the collar's own fit residual (5.9e-4) of the sphere:
-        // 1.3e-3 seen (the fill of fullness and height 1, before the choice, lay 5.7e-3 off)
-        assert!(off < 1.5e-3, "{off}");
+        // lies near the sphere: 1.85e-3 seen at both orders (1.3e-3 with the collar's
+        // earlier parameters, whose fit was four times coarser but whose distance on the
+        // bench's three caps was 7.6e-4 against 5.0e-4 now; the fill of fullness and
+        // height 1, before the choice, lay 5.7e-3 off)
+        assert!(off < 2.1e-3, "{off}");
     }
 }
 
@@ -267,4 +269,44 @@ fn saddle_hole_filled_near_the_saddle() {
     eprintln!("off the saddle {off:.2e}; fullness {:.3}, height {:.3}", f.fullness, f.height);
     assert!(off < 3e-3, "{off}");
     assert!(f.continuity.g2 < 1e-7, "{}", f.continuity.g2);
+}
+
+/// The torus's staircase hole with its loop started at each of its vertices: the collar
+/// fits every start (the spine's breakpoints are laid from the first vertex; measured
+/// with the signed distance `±|x − P(w)|`, 36 of the 54 starts were refused as folding
+/// and the loop's vertices lay up to 6e-3 off the collar), and the fill's distance to the
+/// torus stays within a factor 2 over a spread of starts (1.7e-3 … 2.7e-3 seen over all
+/// 54; with three of the `D_k`'s breakpoints a spine span, 1.8e-3 … 1.0e-2).
+#[test]
+fn collar_does_not_depend_on_the_loops_first_vertex() {
+    use super::shapes::torus;
+    let m = torus(128, 64, 1.0, 0.4, Vec3::new(1.0, 0.0, 0.4), 0.3);
+    let loops = boundary(&m).unwrap();
+    let adj = adjacency(&m);
+    let n = loops[0].vertices.len();
+    let rotated = |r: usize| {
+        let mut l = loops[0].clone();
+        l.vertices.rotate_left(r);
+        l
+    };
+    let mut worst = (0.0f64, 0.0f64);
+    for r in 0..n {
+        let fit = fit_collar(&m, &adj, &rotated(r), 3).unwrap_or_else(|e| panic!("start {r}: {e}"));
+        worst = (max_nan(worst.0, fit.loop_residual), max_nan(worst.1, fit.max_residual));
+        // of all the vertices fitted (at their feet, the loop's too) 1.4e-4 … 2.3e-4 seen
+        // on this mesh of edges ~0.045 around a tube of radius 0.4; at the loop's own
+        // parameters 1.07e-2, where the feet of its notches' vertices step back along the
+        // spine and are moved forward (`loop_parameters`)
+        assert!(fit.max_residual < 5e-4 && fit.loop_residual < 1.5e-2, "start {r}: {fit:?}");
+    }
+    eprintln!("residual at the loop {:.2e}, of all {:.2e}", worst.0, worst.1);
+    let off = |r: usize| {
+        let o = LoopFillOptions { order: 6, ..Default::default() };
+        let f = fill_loop(&m, &rotated(r), m.positions.len() as u32, &o).unwrap_or_else(|e| panic!("start {r}: {e}"));
+        f.positions.iter().fold(0.0, |a: f64, p| max_nan(a, ((p.x.hypot(p.y) - 1.0).hypot(p.z) - 0.4).abs()))
+    };
+    let offs: Vec<f64> = [0, 7, 15, 33, 48].map(off).to_vec();
+    let (lo, hi) = offs.iter().fold((f64::INFINITY, 0.0f64), |a, &d| (a.0.min(d), max_nan(a.1, d)));
+    eprintln!("{offs:?}");
+    assert!(hi < 3e-3 && hi < 2.0 * lo, "{offs:?}");
 }
