@@ -544,6 +544,22 @@ fn check_orientation(
     Ok(())
 }
 
+/// For each loop edge `(v_i, v_{i+1})`, the triangle that runs it.
+pub(super) fn triangles_on_loop(m: &TriMesh, lp: &MeshLoop) -> Vec<usize> {
+    let n = lp.vertices.len();
+    let mut want: std::collections::HashMap<(u32, u32), usize> =
+        (0..n).map(|i| ((lp.vertices[i], lp.vertices[(i + 1) % n]), i)).collect();
+    let mut out = vec![usize::MAX; n];
+    for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
+        for e in [(a, b), (b, c), (c, a)] {
+            if let Some(i) = want.remove(&e) {
+                out[i] = t;
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -578,20 +594,4 @@ mod tests {
         // NaN feet are refused, not ordered
         assert!(loop_parameters(&[0.0, f64::NAN, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0], &x, 8.0).is_err());
     }
-}
-
-/// For each loop edge `(v_i, v_{i+1})`, the triangle that runs it.
-pub(super) fn triangles_on_loop(m: &TriMesh, lp: &MeshLoop) -> Vec<usize> {
-    let n = lp.vertices.len();
-    let mut want: std::collections::HashMap<(u32, u32), usize> =
-        (0..n).map(|i| ((lp.vertices[i], lp.vertices[(i + 1) % n]), i)).collect();
-    let mut out = vec![usize::MAX; n];
-    for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
-        for e in [(a, b), (b, c), (c, a)] {
-            if let Some(i) = want.remove(&e) {
-                out[i] = t;
-            }
-        }
-    }
-    out
 }
