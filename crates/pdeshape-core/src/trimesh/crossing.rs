@@ -117,7 +117,7 @@ pub fn crossings(m: &TriMesh, first_new: usize, limit: usize) -> Vec<(usize, usi
 /// from `base`) cross none of `m`'s triangles and none of each other: [`crossings`] on a
 /// local mesh of the new triangles and the input triangles whose boxes meet theirs.
 pub(super) fn crossing_free(m: &TriMesh, positions: &[Vec3], triangles: &[[u32; 3]], base: u32) -> bool {
-    let at = |i: u32| if i < base { m.positions[i as usize] } else { positions[(i - base) as usize] };
+    let at = |i: u32| super::position(m, positions, base, i);
     let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut hi = -lo;
     for t in triangles {

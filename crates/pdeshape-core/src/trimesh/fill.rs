@@ -37,7 +37,7 @@ use super::band::{Band, BandInput, BandVertex, apex_band};
 use super::collar::{CollarError, CollarFit, DomainLine, adjacency, fit_collar, triangles_on_loop};
 use super::crossing::crossing_free;
 use super::flip::flip_to_delaunay;
-use super::{LoopKind, MeshLoop, TriMesh};
+use super::{LoopKind, MeshLoop, TriMesh, position};
 use crate::Vec3;
 use crate::data::FieldRef;
 use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, Fill, FillEdge, FillError, FillOptions, Host};
@@ -271,10 +271,6 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
             }
             None => lp_ring.clone(),
         };
-        let band_pos: Vec<Vec3> = band.map_or(Vec::new(), |b| b.vertices.iter().map(|v| v.p).collect());
-        let at_band = |i: u32| {
-            if (i as usize) < m.positions.len() { m.positions[i as usize] } else { band_pos[(i - base) as usize] }
-        };
         for (j, &(u, nj)) in plan.iter().enumerate() {
             let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
             // the fill's boundary over the loop gets the loop's mid-`v`: a strip of quads
@@ -292,7 +288,9 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
             if j == 0 && band.is_some() {
                 // a boundary vertex within 0.4 h of a band vertex is left out (never three
                 // neighbours): the band's vertices lie unevenly close to the boundary
-                let near = |p: Vec3| ring_prev.iter().any(|r| (at_band(r.2) - p).norm() < 0.4 * h);
+                // (`positions` holds the band's vertices only, so far)
+                let near =
+                    |p: Vec3| ring_prev.iter().any(|r| (position(m, &positions, base, r.2) - p).norm() < 0.4 * h);
                 let mut keep = vec![true; pts.len()];
                 for k in 0..pts.len() {
                     let prev_dropped = k > 1 && !keep[k - 1] && !keep[k - 2];
@@ -317,9 +315,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
                     (v, y, base + positions.len() as u32 - 1)
                 })
                 .collect();
-            let at = |i: u32| {
-                if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
-            };
+            let at = |i: u32| position(m, &positions, base, i);
             zip(&ring_prev, &ring, &at, &mut triangles);
             ring_prev = ring;
         }
@@ -330,9 +326,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
             triangles.push([ring_prev[(i + 1) % np].2, ring_prev[i].2, pole]);
         }
         if flips {
-            let at = |i: u32| {
-                if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
-            };
+            let at = |i: u32| position(m, &positions, base, i);
             let exists = |a: u32, b: u32| a < base && b < base && adj[a as usize].binary_search(&b).is_ok();
             let budget = 8 * triangles.len();
             let frozen = |t: &[u32; 3]| (0..3).any(|k| on_seam.contains(&(t[k], t[(k + 1) % 3])));
@@ -342,12 +336,10 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     };
     // the band over the loop's edges, flipped; else the loop zipped to the fill's
     // boundary, flipped; else that unflipped: the first whose triangles cross nothing
-    let tries = [(band.as_ref(), true), (None, true), (None, false)];
+    let tries: Vec<(Option<&Band>, bool)> =
+        band.as_ref().map(|b| (Some(b), true)).into_iter().chain([(None, true), (None, false)]).collect();
     let mut made = None;
     for (k, &(b, flips)) in tries.iter().enumerate() {
-        if b.is_none() && k == 0 {
-            continue;
-        }
         let Some(mesh) = build(b, flips) else { continue };
         let last = k + 1 == tries.len();
         if last || crossing_free(original.0, &mesh.0, &mesh.1, base) {
@@ -357,9 +349,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     }
     let (positions, triangles) = made.ok_or(LoopFillError::Crease)?;
     // measures: the seam's dihedral angles and the new edges' lengths
-    let at = |i: u32| {
-        if (i as usize) < m.positions.len() { m.positions[i as usize] } else { positions[(i - base) as usize] }
-    };
+    let at = |i: u32| position(m, &positions, base, i);
     let normal = |t: &[u32; 3]| (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
     let (m, lp) = (original.0, original.1);
     let n = lp.vertices.len();

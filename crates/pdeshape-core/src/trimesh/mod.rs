@@ -45,5 +45,11 @@ impl TriMesh {
     }
 }
 
+/// Vertex `i` of a fill: input vertex `i` of `m` below `base`, else new vertex `i − base`
+/// of `new`.
+fn position(m: &TriMesh, new: &[Vec3], base: u32, i: u32) -> Vec3 {
+    if i < base { m.positions[i as usize] } else { new[(i - base) as usize] }
+}
+
 #[cfg(test)]
 mod tests;
