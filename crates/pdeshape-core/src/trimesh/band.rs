@@ -148,6 +148,9 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         (s, w + inp.period * (k / n) as f64)
     };
     let x = |k: usize| inp.pos[k % n];
+    // the collar's unit normal at each loop vertex, once
+    let normals: Vec<Option<Vec3>> = inp.params.iter().map(|&(s, w)| collar_normal(inp.collar, s, w)).collect();
+    let vn = |k: usize| normals[k % n];
     // `s` and `w` are lengths: an apex lies within a few edges of where its search starts
     let reach = 8.0 * h;
     // the apex over loop vertices a..=b (b > a, unwrapped)
@@ -175,7 +178,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         let xv = x(a + 1);
         let (u0, u1) = ((x(a) - xv).normalized()?, (x(a + 2) - xv).normalized()?);
         let pv = param(a + 1);
-        let nrm = collar_normal(inp.collar, pv.0, pv.1)?;
+        let nrm = vn(a + 1)?;
         let b = (u0 + u1).normalized()?;
         let side = b.cross(nrm).normalized()?;
         let half = 0.5 * u0.cross(u1).norm().atan2(u0.dot(u1));
@@ -184,23 +187,23 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         let cs = collar_first(inp.collar, pv.0, pv.1)[1].norm().max(1e-300);
         point_on_collar(inp.collar, [(xv, side, 0.0), (xv, b, r)], (pv.0 - r / cs, pv.1), reach)
     };
-    // does the triangle (p, q, r) face the collar's normal at `at`?
-    let faces = |p: Vec3, q: Vec3, r: Vec3, at: (f64, f64)| -> bool {
+    // does the triangle (p, q, r) face the collar's normal at loop vertex `v`?
+    let faces = |p: Vec3, q: Vec3, r: Vec3, v: usize| -> bool {
         let nn = (q - p).cross(r - p);
-        collar_normal(inp.collar, at.0, at.1).is_some_and(|c| nn.dot(c) > 0.2 * nn.norm())
+        vn(v).is_some_and(|c| nn.dot(c) > 0.2 * nn.norm())
     };
     // groups of loop edges (first vertex, edge count), cyclic, each with its apex
     // the angle at loop vertex v from p to q, counter-clockwise about the collar's normal,
     // in (0, 2π]
     let fan = |v: usize, p: Vec3, q: Vec3| -> f64 {
         let (d0, d1) = (p - x(v), q - x(v));
-        let nrm = collar_normal(inp.collar, param(v).0, param(v).1).unwrap_or(Vec3::ZERO);
+        let nrm = vn(v).unwrap_or(Vec3::ZERO);
         let a = d0.cross(d1).dot(nrm).atan2(d0.dot(d1));
         if a <= 0.0 { a + 2.0 * PI } else { a }
     };
     // does the loop turn left at v (towards the mesh: a peak into the hole)?
     let peak = |v: usize| {
-        let nrm = collar_normal(inp.collar, param(v).0, param(v).1).unwrap_or(Vec3::ZERO);
+        let nrm = vn(v).unwrap_or(Vec3::ZERO);
         (x(v) - x(v + n - 1)).cross(x(v + 1) - x(v)).dot(nrm) > 0.0
     };
     // first the notches (the loop turning right, towards the hole, by a hole-side angle
@@ -208,7 +211,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
     let mut notches: Vec<(f64, usize)> = (0..n)
         .filter_map(|v| {
             let (e1, e2) = (x(v + n - 1) - x(v), x(v + 1) - x(v));
-            let nrm = collar_normal(inp.collar, param(v).0, param(v).1)?;
+            let nrm = vn(v)?;
             let right = (x(v) - x(v + n - 1)).cross(x(v + 1) - x(v)).dot(nrm) < 0.0;
             let angle = e1.cross(e2).norm().atan2(e1.dot(e2));
             (right && angle < NOTCH).then_some((angle, v))
@@ -223,8 +226,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         if taken[e0] || taken[e1] {
             continue;
         }
-        if let Some(b) = notch_apex(e0).filter(|b| (0..2).all(|e| faces(x(e0 + e + 1), x(e0 + e), b.p, param(e0 + e))))
-        {
+        if let Some(b) = notch_apex(e0).filter(|b| (0..2).all(|e| faces(x(e0 + e + 1), x(e0 + e), b.p, e0 + e))) {
             pair[e0] = Some(b);
             taken[e0] = true;
             taken[e1] = true;
@@ -262,7 +264,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
             let d = (a.2.p - b.2.p).norm();
             let phi = fan(v, a.2.p, b.2.p);
             // a reflex fan at a peak of the loop is split below; elsewhere it has turned over
-            let open = faces(x(v), a.2.p, b.2.p, param(v)) || (peak(v) && (PI - 0.35..=1.6 * PI).contains(&phi));
+            let open = faces(x(v), a.2.p, b.2.p, v) || (peak(v) && (PI - 0.35..=1.6 * PI).contains(&phi));
             let bad = if open { d } else { -1.0 };
             if bad < 0.5 * h && !(bad >= 0.0 && kept[v]) && worst.is_none_or(|w| bad < w.1) {
                 worst = Some((j, bad));
@@ -280,7 +282,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         }
         let pair = if len == 2 && !peak(start + 1) { notch_apex(start) } else { None };
         let ap = match pair {
-            Some(b) if (0..2).all(|e| faces(x(start + e + 1), x(start + e), b.p, param(start + e))) => b,
+            Some(b) if (0..2).all(|e| faces(x(start + e + 1), x(start + e), b.p, start + e)) => b,
             _ => apex(start, start + len)?,
         };
         groups[j] = (start, len, ap);
@@ -289,7 +291,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
     // every edge's triangle faces the collar's normal
     for &(a, len, ap) in &groups {
         for e in a..a + len {
-            if !faces(x(e + 1), x(e), ap.p, param(e)) {
+            if !faces(x(e + 1), x(e), ap.p, e) {
                 return None;
             }
         }
@@ -314,14 +316,14 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
                 point_over(inp.collar, xv, t, height, (pv.0 - height / cs, pv.1), reach)
             });
             if let Some(b) = split.filter(|b| {
-                faces(xv, prev.p, b.p, pv)
-                    && faces(xv, b.p, ap.p, pv)
+                faces(xv, prev.p, b.p, v)
+                    && faces(xv, b.p, ap.p, v)
                     && (b.p - prev.p).norm() >= 0.5 * h
                     && (b.p - ap.p).norm() >= 0.5 * h
             }) {
                 vertices.push(b);
                 split_id[j] = Some(base + vertices.len() as u32 - 1);
-            } else if phi >= PI - 0.35 || !faces(xv, prev.p, ap.p, pv) {
+            } else if phi >= PI - 0.35 || !faces(xv, prev.p, ap.p, v) {
                 return None;
             }
         }
