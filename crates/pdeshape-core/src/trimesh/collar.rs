@@ -49,9 +49,29 @@ use std::cmp::Ordering;
 /// constant in time).
 #[derive(Clone, Debug)]
 pub struct Collar {
-    spine: NurbsCurve,
-    d: [NurbsCurve; 4],
+    /// The spine `P`: its basis and control points.
+    spine: (PeriodicSpline, Vec<Vec3>),
+    /// The `D_k`: their common basis and each one's control points.
+    d: (PeriodicSpline, [Vec<Vec3>; 4]),
     period: f64,
+}
+
+/// The Taylor coefficients `(dʲ/dwʲ) / j!`, `j = 0 ..= nd`, of the splines with control
+/// points `ctrl` on `basis` at `w` (as a jet holds them), the basis evaluated once for all
+/// of them (zero above the third derivative).
+fn spline_derivatives<const K: usize>(basis: &PeriodicSpline, ctrl: [&[Vec3]; K], w: f64, nd: usize) -> [Vec<Vec3>; K] {
+    let (j0, b) = basis.basis(w, nd);
+    let len = basis.len();
+    let factorial = [1.0, 1.0, 2.0, 6.0];
+    ctrl.map(|c| {
+        (0..=nd)
+            .map(|j| {
+                b.get(j).map_or(Vec3::ZERO, |row| {
+                    (0..4).fold(Vec3::ZERO, |a, r| a + c[(j0 + r) % len] * row[r]) * (1.0 / factorial[j])
+                })
+            })
+            .collect()
+    })
 }
 
 impl Field for Collar {
@@ -62,17 +82,16 @@ impl Field for Collar {
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
         let [os, ow, _] = shape.orders();
         let (s, w) = (at[0], at.get(1).copied().unwrap_or(0.0).rem_euclid(self.period));
-        let cs = JetShape::new(&[ow]);
-        let curves: Vec<VecJet> = self.d.iter().chain([&self.spine]).map(|c| c.jet(&[w], cs)).collect();
+        let [p] = spline_derivatives(&self.spine.0, [&self.spine.1], w, ow);
+        let dk = spline_derivatives(&self.d.0, self.d.1.each_ref().map(|c| c.as_slice()), w, ow);
         let binom = |k: usize, i: usize| -> f64 { (1..=i).map(|r| (k + 1 - r) as f64 / r as f64).product() };
         VecJet(std::array::from_fn(|q| {
             let mut c = vec![0.0; shape.len()];
             for i in 0..=os.min(3) {
                 for j in 0..=ow {
-                    let mut v: f64 =
-                        (i..=3).map(|k| binom(k, i) * s.powi((k - i) as i32) * curves[k].0[q].coeff([j, 0, 0])).sum();
+                    let mut v: f64 = (i..=3).map(|k| binom(k, i) * s.powi((k - i) as i32) * dk[k][j][q]).sum();
                     if i == 0 {
-                        v += curves[4].0[q].coeff([j, 0, 0]);
+                        v += p[j][q];
                     }
                     c[shape.index([i, j, 0])] = v;
                 }
@@ -285,7 +304,8 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
         ((0..4).map(|r| ((j0 + r) % spine_controls, b[0][r])).collect(), xi)
     });
     let (sol_spine, _) = penalised_fit(spine_controls, 1, rows)?;
-    let spine = us.curve(&column(&sol_spine, 0..spine_controls, 1.0));
+    let spine_ctrl = column(&sol_spine, 0..spine_controls, 1.0);
+    let spine = us.curve(&spine_ctrl);
     // the vertices within `rings` rings, each with the loop vertex it was reached from
     let mut origin: Vec<Option<usize>> = vec![None; m.positions.len()];
     let mut front: Vec<u32> = lp.vertices.clone();
@@ -349,9 +369,9 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
         (cols, d)
     });
     let (sol, cond) = penalised_fit(4 * controls, 4, rows)?;
-    let d: [NurbsCurve; 4] =
-        std::array::from_fn(|k| ub.curve(&column(&sol, k * controls..(k + 1) * controls, width.powi(-(k as i32)))));
-    let collar = Collar { spine, d, period };
+    let d: [Vec<Vec3>; 4] =
+        std::array::from_fn(|k| column(&sol, k * controls..(k + 1) * controls, width.powi(-(k as i32))));
+    let collar = Collar { spine: (us.clone(), spine_ctrl), d: (ub, d), period };
     let mut sq = 0.0;
     let mut max_residual: f64 = 0.0;
     for (&(v, _), &(w, s, _)) in pts.iter().zip(&feet) {
@@ -593,5 +613,56 @@ mod tests {
         assert!(loop_parameters(&[0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0], &x, 8.0).is_err());
         // NaN feet are refused, not ordered
         assert!(loop_parameters(&[0.0, f64::NAN, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0], &x, 8.0).is_err());
+    }
+
+    /// The collar's jet (the bases evaluated once, `spline_derivatives`) against the same
+    /// splines as `NurbsCurve`s (the B-spline module's own jets): `Σ s^k D_k` expanded by
+    /// hand at 50 pseudo-random `(s, w)`, every Taylor coefficient up to order (3, 5).
+    #[test]
+    fn jet_matches_the_nurbs_curves() {
+        let period = 2.0;
+        let (us, ub) = (
+            PeriodicSpline::new((0..6).map(|j| period * j as f64 / 6.0).collect(), period).unwrap(),
+            PeriodicSpline::new((0..15).map(|j| period * j as f64 / 15.0).collect(), period).unwrap(),
+        );
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut pts = |n: usize| -> Vec<Vec3> { (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect() };
+        let spine = pts(6);
+        let d: [Vec<Vec3>; 4] = std::array::from_fn(|_| pts(15));
+        let collar = Collar { spine: (us.clone(), spine.clone()), d: (ub.clone(), d.clone()), period };
+        let curves: Vec<NurbsCurve> = d.iter().map(|c| ub.curve(c)).chain([us.curve(&spine)]).collect();
+        let shape = JetShape::new(&[3, 5]);
+        for _ in 0..50 {
+            let (s, w) = (0.6 * rnd(), 3.0 * rnd());
+            let got = collar.jet(&[s, w], shape);
+            let cj: Vec<VecJet> = curves.iter().map(|c| c.jet(&[w.rem_euclid(period)], JetShape::new(&[5]))).collect();
+            for i in 0..=3 {
+                for j in 0..=5 {
+                    for q in 0..3 {
+                        // d^i/ds^i of s^k over i!: C(k, i) s^(k−i)
+                        let binom =
+                            [[1.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0], [1.0, 2.0, 1.0, 0.0], [1.0, 3.0, 3.0, 1.0]];
+                        let mut want: f64 =
+                            (i..4).map(|k| binom[k][i] * s.powi((k - i) as i32) * cj[k].0[q].coeff([j, 0, 0])).sum();
+                        if i == 0 {
+                            want += cj[4].0[q].coeff([j, 0, 0]);
+                        }
+                        let have = got.0[q].coeff([i, j, 0]);
+                        // coefficients of size ≤ 10³ (derivatives over breakpoint gaps of 0.13)
+                        // summed a few at a time: round-off
+                        assert!(
+                            (have - want).abs() <= 1e-12 * (1.0 + want.abs()),
+                            "({i}, {j}) q {q}: {have} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
