@@ -15,9 +15,9 @@
 //!    least-squares spline (on the spine's breakpoints) through the unit normals of the
 //!    triangles on the loop, so `s` is positive on the mesh's side. Not `±|x − P(w)|`:
 //!    the spine, a smoothed loop, lies off the surface, and that distance never comes
-//!    below the offset, so it folds the vertices near the spine onto each other (on the tests' torus
-//!    the fit's residual at the loop was 5–23 times larger, and which loop vertex came
-//!    first decided whether the collar folded).
+//!    below the offset, so it folds the vertices near the spine onto each other (on the
+//!    tests' torus the fit's residual at the loop was 5–23 times larger, and which loop
+//!    vertex came first decided whether the collar folded).
 //! 3. **Surface.** `C(s, w) = P(w) + Σ_{k=0}^{3} s^k D_k(w)`, `D_k` periodic cubic
 //!    splines on five times the spine's breakpoints (fewer where vertices are few), fitted
 //!    by linear least squares to all those vertices (a second-difference penalty of 10⁻⁶
