@@ -299,12 +299,7 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
     let spine_controls = (n / 6).clamp(6, 64);
     let us = uniform(spine_controls);
     // 1. the spine
-    let rows = chord.iter().zip(&x).map(|(&t, &xi)| {
-        let (j0, b) = us.basis(t, 0);
-        ((0..4).map(|r| ((j0 + r) % spine_controls, b[0][r])).collect(), xi)
-    });
-    let (sol_spine, _) = penalised_fit(spine_controls, 1, rows)?;
-    let spine_ctrl = column(&sol_spine, 0..spine_controls, 1.0);
+    let spine_ctrl = fit_curve(&us, chord.iter().copied().zip(x.iter().copied()))?;
     let spine = us.curve(&spine_ctrl);
     // the vertices within `rings` rings, each with the loop vertex it was reached from
     let mut origin: Vec<Option<usize>> = vec![None; m.positions.len()];
@@ -485,15 +480,23 @@ fn normal_along(
     basis: &PeriodicSpline,
 ) -> Result<NurbsCurve, LinalgError> {
     let n = chord.len();
-    let c = basis.len();
-    let rows = (0..n).filter_map(|i| {
+    let data = (0..n).filter_map(|i| {
         let next = if i + 1 == n { period } else { chord[i + 1] };
-        let (j0, b) = basis.basis(0.5 * (chord[i] + next), 0);
-        let unit = m.face_normal(on_loop[i]).normalized()?;
-        Some(((0..4).map(|r| ((j0 + r) % c, b[0][r])).collect(), unit))
+        Some((0.5 * (chord[i] + next), m.face_normal(on_loop[i]).normalized()?))
+    });
+    Ok(basis.curve(&fit_curve(basis, data)?))
+}
+
+/// The control points of the periodic cubic spline on `basis` fitted to `data` (parameter,
+/// point) by penalised least squares ([`penalised_fit`]).
+fn fit_curve(basis: &PeriodicSpline, data: impl Iterator<Item = (f64, Vec3)>) -> Result<Vec<Vec3>, LinalgError> {
+    let c = basis.len();
+    let rows = data.map(|(t, p)| {
+        let (j0, b) = basis.basis(t, 0);
+        ((0..4).map(|r| ((j0 + r) % c, b[0][r])).collect(), p)
     });
     let (sol, _) = penalised_fit(c, 1, rows)?;
-    Ok(basis.curve(&column(&sol, 0..c, 1.0)))
+    Ok(column(&sol, 0..c, 1.0))
 }
 
 /// The foot of `x` on the spine `p`: the nearest of 16 samples a loop edge within `reach`
