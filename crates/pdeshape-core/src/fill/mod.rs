@@ -52,6 +52,7 @@
 mod crease;
 mod curve;
 mod data;
+mod family;
 mod foot;
 mod foot_series;
 
@@ -62,6 +63,7 @@ use crate::patch::{Condition, Surface, VDomain};
 use crate::spectral::{SpectralError, SpectralOptions, SpectralPatch};
 pub use curve::{AlongCurve, DomainCurve, Host};
 use data::{LoopData, Piece, second_frame};
+pub use family::FillFamily;
 pub use foot::{FootCurve, FootError, foot_of};
 pub use foot_series::FootSeries;
 use std::f64::consts::TAU;
@@ -248,6 +250,11 @@ impl Field for Ring {
     }
 }
 
+/// `0` for every `v`.
+fn zero_field() -> FieldRef {
+    Arc::new(Ring { centre: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, rho: 0.0 })
+}
+
 fn point_frame(e: &FillEdge, w: f64, t: f64) -> (Vec3, Vec3, Vec3) {
     let j = e.surface.jet(&[e.s0, w, t], JetShape::new(&[1, 1, 0]));
     let g = |m: [usize; 3]| Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m));
@@ -404,41 +411,71 @@ struct PoleData<T = f64, P = Vec3> {
 /// `X = X₀ + Σᵢ xᵢ Bᵢ` (`X₀` with the free data at 0, `Bᵢ` the patch with zero loop data and
 /// only datum `i` at 1), so `E = ∫₀¹∫₀^{2π} |L X|² dv du` with `L = ∂u² + a²∂v²` — the
 /// energy a biharmonic patch minimises for given boundary data — is least at the solution
-/// of a linear least-squares problem in the free data (midpoint rule, 32 × 64 points;
+/// of a linear least-squares problem in the free data (midpoint rule on [`BendingRule`];
 /// the v-rule is exact for the products of the modes).
 fn least_bending(
-    loop_conds: &[Condition],
+    setup: &LoopSetup,
     fixed_data: &PoleData,
     free: &PoleData<bool, bool>,
-    with_pole: &dyn Fn(&PoleData, &[Condition]) -> Vec<Condition>,
     o: &FillOptions,
-    edges: usize,
 ) -> Result<PoleData, FillError> {
-    // a multiple of the edge count in v, so that the rule keeps the loop's symmetries
-    let (nu, nv) = (32, edges * 64usize.div_ceil(edges));
-    let us: Vec<f64> = (0..nu).map(|i| (i as f64 + 0.5) / nu as f64).collect();
-    let vs: Vec<f64> = (0..nv).map(|j| TAU * j as f64 / nv as f64).collect();
-    let energy_rows = |c: &[Condition]| -> Result<Vec<Vec3>, FillError> {
-        let p = SpectralPatch::new(c, VDomain::PERIODIC, o.spectral)?;
-        Ok(p.grid2(&us, &vs)
-            .iter()
+    let rule = BendingRule::new(setup.edges);
+    let base = rule.rows(&SpectralPatch::new(
+        &setup.with_pole(fixed_data, &setup.conds, o.order),
+        VDomain::PERIODIC,
+        o.spectral,
+    )?);
+    let zero_loop = setup.zero_loop();
+    let cols: Vec<Vec<Vec3>> = unit_poles(free)
+        .iter()
+        .map(|d| {
+            Ok(rule.rows(&SpectralPatch::new(&setup.with_pole(d, &zero_loop, o.order), VDomain::PERIODIC, o.spectral)?))
+        })
+        .collect::<Result<_, FillError>>()?;
+    let x = bending_solve(&cols, &[base])?;
+    let mut out = *fixed_data;
+    set_free(&mut out, free, (0..cols.len()).map(|i| x[(i, 0)]));
+    Ok(out)
+}
+
+/// The midpoint rule of [`least_bending`]'s energy: 32 points in `u`, and in `v` a multiple
+/// of the edge count near 64 (so that the rule keeps the loop's symmetries).
+struct BendingRule {
+    us: Vec<f64>,
+    vs: Vec<f64>,
+}
+
+impl BendingRule {
+    fn new(edges: usize) -> BendingRule {
+        let (nu, nv) = (32, edges * 64usize.div_ceil(edges));
+        BendingRule {
+            us: (0..nu).map(|i| (i as f64 + 0.5) / nu as f64).collect(),
+            vs: (0..nv).map(|j| TAU * j as f64 / nv as f64).collect(),
+        }
+    }
+
+    /// `√r (X_rr + X_r/r + X_θθ/r²)` at the rule's points (`r = 1 − u`), from the patch's
+    /// `[X, X_u, X_v, X_uu, X_uv, X_vv]` there.
+    fn rows(&self, p: &dyn Surface) -> Vec<Vec3> {
+        self.rows_of(&p.grid2(&self.us, &self.vs))
+    }
+
+    fn rows_of(&self, g: &[[Vec3; 6]]) -> Vec<Vec3> {
+        let nv = self.vs.len();
+        g.iter()
             .enumerate()
             .map(|(k, d)| {
-                let r = 1.0 - us[k / nv];
+                let r = 1.0 - self.us[k / nv];
                 (d[3] - d[1] * (1.0 / r) + d[5] * (1.0 / (r * r))) * r.sqrt()
             })
-            .collect())
-    };
-    let zero_loop: Vec<Condition> = loop_conds
-        .iter()
-        .map(|c| Condition {
-            u: c.u,
-            order: c.order,
-            data: Arc::new(Ring { centre: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, rho: 0.0 }),
-        })
-        .collect();
+            .collect()
+    }
+}
+
+/// The unit data, one per free datum in the order pole x, y, z, ring, σ.
+fn unit_poles(free: &PoleData<bool, bool>) -> Vec<PoleData> {
     let zero = PoleData { pole: Vec3::ZERO, ring: 0.0, sigma: 0.0 };
-    let mut unit: Vec<PoleData> = Vec::new();
+    let mut unit = Vec::new();
     if free.pole {
         for e in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.0, 1.0)] {
             unit.push(PoleData { pole: e, ..zero });
@@ -450,32 +487,61 @@ fn least_bending(
     if free.sigma {
         unit.push(PoleData { sigma: 1.0, ..zero });
     }
-    let base = energy_rows(&with_pole(fixed_data, loop_conds))?;
-    let cols: Vec<Vec<Vec3>> = unit.iter().map(|d| energy_rows(&with_pole(d, &zero_loop))).collect::<Result<_, _>>()?;
-    let rows = base.len() * 3;
-    let a = faer::Mat::<f64>::from_fn(rows, cols.len(), |r, c| cols[c][r / 3][r % 3]);
-    let b = faer::Mat::<f64>::from_fn(rows, 1, |r, _| -base[r / 3][r % 3]);
-    let (x, _cond) = crate::linalg::least_squares(&a, &b, 1e12)
-        .map_err(|e| FillError::Loop(format!("the least-bending pole could not be found: {e}")))?;
-    let mut out = *fixed_data;
-    let mut k = 0;
+    unit
+}
+
+/// Writes the free data, in [`unit_poles`]' order, into `d`.
+fn set_free(d: &mut PoleData, free: &PoleData<bool, bool>, mut x: impl Iterator<Item = f64>) {
+    let mut next = || x.next().unwrap_or(f64::NAN);
     if free.pole {
-        out.pole = Vec3::new(x[(0, 0)], x[(1, 0)], x[(2, 0)]);
-        k = 3;
+        d.pole = Vec3::new(next(), next(), next());
     }
     if free.ring {
-        out.ring = x[(k, 0)];
-        k += 1;
+        d.ring = next();
     }
     if free.sigma {
-        out.sigma = x[(k, 0)];
+        d.sigma = next();
     }
-    Ok(out)
+}
+
+/// The least-squares coefficients `x` with `Σᵢ xᵢ colsᵢ ≈ −base` for each `base`
+/// (one column of the result each).
+fn bending_solve(cols: &[Vec<Vec3>], bases: &[Vec<Vec3>]) -> Result<faer::Mat<f64>, FillError> {
+    let rows = cols[0].len() * 3;
+    let a = faer::Mat::<f64>::from_fn(rows, cols.len(), |r, c| cols[c][r / 3][r % 3]);
+    let b = faer::Mat::<f64>::from_fn(rows, bases.len(), |r, c| -bases[c][r / 3][r % 3]);
+    let (x, _cond) = crate::linalg::least_squares(&a, &b, 1e12)
+        .map_err(|e| FillError::Loop(format!("the least-bending pole could not be found: {e}")))?;
+    Ok(x)
+}
+
+/// A loop made ready for its fill: its conditions at `u = 0` and what the pole's
+/// construction needs. The fill is this plus the pole's data ([`LoopSetup::finish`]).
+struct LoopSetup {
+    /// Position, cross tangent and (order 6) second cross derivative along the loop.
+    conds: Vec<Condition>,
+    position: Arc<LoopData>,
+    /// The pole ring's in-plane frame: `e₁` towards the loop's `v = 0` point, `e₂ = n̄ × e₁`.
+    e1: Vec3,
+    e2: Vec3,
+    /// Edges after dropping point-like ones and splitting at creases.
+    edges: usize,
+    mean_fullness: f64,
+    /// All but the pole's figures.
+    report: FillReport,
 }
 
 impl Fill {
     /// Fills the hole bounded by `edges` (in loop order).
     pub fn new(edges: &[FillEdge], o: &FillOptions) -> Result<Fill, FillError> {
+        let setup = LoopSetup::new(edges, o)?;
+        let data = setup.pole_data(o)?;
+        setup.finish(o, data)
+    }
+}
+
+impl LoopSetup {
+    fn new(edges: &[FillEdge], o: &FillOptions) -> Result<LoopSetup, FillError> {
         let n = edges.len();
         if n < 3 {
             return Err(FillError::Loop(format!("a hole needs at least 3 edges; got {n}")));
@@ -537,9 +603,9 @@ impl Fill {
                     point_like.len()
                 )));
             }
-            let mut fill = Fill::new(&kept, o)?;
-            fill.report.dropped_edges = point_like;
-            return Ok(fill);
+            let mut setup = LoopSetup::new(&kept, o)?;
+            setup.report.dropped_edges = point_like;
+            return Ok(setup);
         }
         // creases of a neighbour inside an edge become corners: the edge is split there
         if o.split_creases {
@@ -555,9 +621,9 @@ impl Fill {
                 pieces.push(FillEdge { w: (start, e.w.1), ..e.clone() });
             }
             if !split.is_empty() {
-                let mut fill = Fill::new(&pieces, &FillOptions { split_creases: false, ..o.clone() })?;
-                fill.report.split_edges = split;
-                return Ok(fill);
+                let mut setup = LoopSetup::new(&pieces, &FillOptions { split_creases: false, ..o.clone() })?;
+                setup.report.split_edges = split;
+                return Ok(setup);
             }
         }
         for k in 0..n {
@@ -699,7 +765,6 @@ impl Fill {
             return Err(FillError::Loop("the loop's first point is above its centroid".into()));
         };
         let e2 = normal.cross(e1);
-        let fixed = |centre: Vec3, rho: f64| -> FieldRef { Arc::new(Ring { centre, e1, e2, rho }) };
         // the loop's data are asked at the same v by every cell of a grid (and cost much
         // per point on CAD faces): kept per point
         let memo = |f: FieldRef| -> FieldRef { Arc::new(crate::data::MemoField::new(f)) };
@@ -711,55 +776,85 @@ impl Fill {
             let second = Arc::new(LoopData { pieces, order: 2, blend: o.corner_blend });
             conds.push(Condition { u: 0.0, order: 2, data: memo(second) });
         }
-        // the pole's data, `X = P`, `X_u = −ρ (cos v e₁ + sin v e₂)`, order 6 also
-        // `X_uu = σ n̄`: what the user did not set is chosen by least bending
         let mean_fullness = edges.iter().map(|e| e.fullness).sum::<f64>() / n as f64;
+        let report = FillReport {
+            corner_angles,
+            pole: Vec3::ZERO,
+            centroid,
+            radius,
+            normal,
+            corner_curvature_gaps,
+            pole_curvature: None,
+            dropped_edges: Vec::new(),
+            split_edges: Vec::new(),
+        };
+        Ok(LoopSetup { conds, position, e1, e2, edges: n, mean_fullness, report })
+    }
+
+    /// Which of the pole's data the options leave to least bending.
+    fn free(o: &FillOptions) -> PoleData<bool, bool> {
         let ring_free = o.ring.is_none() && !(o.order == 6 && o.pole_curvature.is_some());
-        let free =
-            PoleData { pole: o.pole.is_none(), ring: ring_free, sigma: o.order == 6 && o.pole_curvature.is_none() };
+        PoleData { pole: o.pole.is_none(), ring: ring_free, sigma: o.order == 6 && o.pole_curvature.is_none() }
+    }
+
+    /// The pole's data as the options set them, 0 where least bending will choose.
+    fn fixed_data(&self, o: &FillOptions) -> PoleData {
+        let free = Self::free(o);
         let mut data = PoleData {
             pole: o.pole.unwrap_or(Vec3::ZERO),
-            ring: o.ring.unwrap_or(if ring_free { 0.0 } else { radius * mean_fullness }),
+            ring: o.ring.unwrap_or(if free.ring { 0.0 } else { self.report.radius * self.mean_fullness }),
             sigma: 0.0,
         };
         if let Some(k) = o.pole_curvature {
             data.sigma = k * data.ring * data.ring;
         }
-        let with_pole = |d: &PoleData, loop_conds: &[Condition]| {
-            let mut c = loop_conds.to_vec();
-            c.push(Condition { u: 1.0, order: 0, data: fixed(d.pole, 0.0) });
-            c.push(Condition { u: 1.0, order: 1, data: fixed(Vec3::ZERO, -d.ring) });
-            if o.order == 6 {
-                c.push(Condition { u: 1.0, order: 2, data: fixed(normal * d.sigma, 0.0) });
-            }
-            c
-        };
-        if free.pole || free.ring || free.sigma {
-            let best = least_bending(&conds, &data, &free, &with_pole, o, n)?;
-            data = best;
-            if free.pole {
-                data.pole = centroid + (data.pole - centroid) * o.height;
-            }
-        }
-        let pole = data.pole;
-        let rho = data.ring;
-        let conds = with_pole(&data, &conds);
-        let pole_curvature = (o.order == 6).then(|| data.sigma / (rho * rho));
-        let patch = Arc::new(SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?);
-        let report = FillReport {
-            corner_angles,
-            pole,
-            centroid,
-            radius,
-            normal,
-            corner_curvature_gaps,
-            pole_curvature,
-            dropped_edges: Vec::new(),
-            split_edges: Vec::new(),
-        };
-        Ok(Fill { patch, conditions: conds.to_vec(), position, report, t })
+        data
     }
 
+    /// The pole's data, `X = P`, `X_u = −ρ (cos v e₁ + sin v e₂)`, order 6 also
+    /// `X_uu = σ n̄`: what the user did not set is chosen by least bending, and `height`
+    /// scales the chosen pole's offset from the centroid.
+    fn pole_data(&self, o: &FillOptions) -> Result<PoleData, FillError> {
+        let free = Self::free(o);
+        let mut data = self.fixed_data(o);
+        if free.pole || free.ring || free.sigma {
+            data = least_bending(self, &data, &free, o)?;
+            if free.pole {
+                data.pole = self.report.centroid + (data.pole - self.report.centroid) * o.height;
+            }
+        }
+        Ok(data)
+    }
+
+    /// `loop_conds` (the loop's, or zero data of the same kinds) followed by the pole's.
+    fn with_pole(&self, d: &PoleData, loop_conds: &[Condition], order: usize) -> Vec<Condition> {
+        let fixed = |centre: Vec3, rho: f64| -> FieldRef { Arc::new(Ring { centre, e1: self.e1, e2: self.e2, rho }) };
+        let mut c = loop_conds.to_vec();
+        c.push(Condition { u: 1.0, order: 0, data: fixed(d.pole, 0.0) });
+        c.push(Condition { u: 1.0, order: 1, data: fixed(Vec3::ZERO, -d.ring) });
+        if order == 6 {
+            c.push(Condition { u: 1.0, order: 2, data: fixed(self.report.normal * d.sigma, 0.0) });
+        }
+        c
+    }
+
+    /// The loop's conditions with zero data.
+    fn zero_loop(&self) -> Vec<Condition> {
+        self.conds.iter().map(|c| Condition { u: c.u, order: c.order, data: zero_field() }).collect()
+    }
+
+    /// The fill with the pole's data `data`.
+    fn finish(self, o: &FillOptions, data: PoleData) -> Result<Fill, FillError> {
+        let conds = self.with_pole(&data, &self.conds, o.order);
+        let patch = Arc::new(SpectralPatch::new(&conds, VDomain::PERIODIC, o.spectral)?);
+        let mut report = self.report;
+        report.pole = data.pole;
+        report.pole_curvature = (o.order == 6).then(|| data.sigma / (data.ring * data.ring));
+        Ok(Fill { patch, conditions: conds, position: self.position, report, t: o.t })
+    }
+}
+
+impl Fill {
     /// The fill surface.
     pub fn patch(&self) -> &Arc<SpectralPatch> {
         &self.patch

@@ -354,3 +354,49 @@ fn a_fills_value_grid_is_its_full_grids_first_entry() {
         }
     }
 }
+
+/// A family member is the fill `Fill::new` builds with the same fullness and height: the
+/// family's claim that the loop's cross data scale as `f` and `f²` and that least bending
+/// is linear in them. Checked on an uneven spherical pentagon (G1 corners, tangential
+/// corner corrections at order 6) and the creased square (split into six edges, corners
+/// that are not G1, so the normal parts of the corner tangents enter), at both orders and
+/// fullness scales and heights away from 1.
+#[test]
+fn a_family_member_is_the_fill_of_its_fullness_and_height() {
+    let loops = [("pentagon", sphere_loop(&[0.0, 1.1, 2.0, 3.4, 4.9], 0.7)), ("creased square", creased_square())];
+    let us: Vec<f64> = (0..9).map(|i| i as f64 / 8.0).collect();
+    let vs: Vec<f64> = (0..24).map(|j| TAU * j as f64 / 24.0 + 0.1).collect();
+    for (name, edges) in &loops {
+        for order in [4, 6] {
+            let o = FillOptions { order, ..FillOptions::default() };
+            let family = FillFamily::new(edges, &o, &us, &vs).unwrap();
+            for (f, h) in [(1.0, 1.0), (0.6, 2.5), (1.7, 0.3)] {
+                let scaled: Vec<FillEdge> = edges.iter().map(|e| FillEdge { fullness: f, ..e.clone() }).collect();
+                let direct = Fill::new(&scaled, &FillOptions { height: h, ..o.clone() }).unwrap();
+                let want = direct.patch().grid2(&us, &vs);
+                let member = family.fill(f, h).unwrap();
+                let got = family.grid2(f, h);
+                let again = member.patch().grid2(&us, &vs);
+                // per derivative, against its largest size on the grid
+                let mut worst = [0.0f64; 2];
+                for d in 0..6 {
+                    let scale = want.iter().map(|g| g[d].norm()).fold(0.0, crate::num::max_nan);
+                    for ((w, g), a) in want.iter().zip(&got).zip(&again) {
+                        worst[0] = crate::num::max_nan(worst[0], (g[d] - w[d]).norm() / scale);
+                        worst[1] = crate::num::max_nan(worst[1], (a[d] - w[d]).norm() / scale);
+                    }
+                }
+                eprintln!(
+                    "{name}, order {order}, f {f}, h {h}: summed grid {:.1e}, member's fill {:.1e}",
+                    worst[0], worst[1]
+                );
+                // sums of ~8 solved patches of size ~1 and a least-squares solve: 5e-15
+                // seen, round-off of the solves and of the sum
+                assert!(worst[0] < 5e-14 && worst[1] < 5e-14, "{name}, order {order}, ({f}, {h}): {worst:?}");
+                let (a, b) = (member.report(), direct.report());
+                assert!((a.pole - b.pole).norm() < 1e-12, "{name}: pole {} against {}", a.pole, b.pole);
+                assert_eq!(a.split_edges, b.split_edges);
+            }
+        }
+    }
+}
