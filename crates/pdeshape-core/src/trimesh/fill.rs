@@ -40,7 +40,7 @@ use super::flip::flip_to_delaunay;
 use super::{LoopKind, MeshLoop, TriMesh, position};
 use crate::Vec3;
 use crate::data::FieldRef;
-use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, Fill, FillEdge, FillError, FillOptions, Host};
+use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, Fill, FillEdge, FillError, FillFamily, FillOptions, Host};
 use crate::num::max_nan;
 use crate::patch::Surface;
 use faer::linalg::solvers::Solve;
@@ -167,21 +167,22 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     // the fills of several fullnesses ask the collar at the same points: kept per point
     let surface: FieldRef = Arc::new(crate::data::MemoField::new(Arc::new(along)));
     // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
-    let make = |[f, height]: [f64; 2]| -> Result<(Fill, f64), LoopFillError> {
-        let edges: Vec<FillEdge> = (0..4)
-            .map(|k| FillEdge {
-                surface: surface.clone(),
-                s0: 0.0,
-                w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
-                fullness: f,
-                side: Some(1.0),
-            })
-            .collect();
-        let fill = Fill::new(&edges, &FillOptions { order: o.order, height, ..FillOptions::default() })?;
-        let e = willmore(fill.patch().as_ref(), 16, 48);
-        Ok((fill, e))
-    };
-    let (fill, [fullness, height], willmore_energy) = fairest(make)?;
+    let edges: Vec<FillEdge> = (0..4)
+        .map(|k| FillEdge {
+            surface: surface.clone(),
+            s0: 0.0,
+            w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
+            fullness: 1.0,
+            side: Some(1.0),
+        })
+        .collect();
+    // every fill of the search from the solves of one (`FillFamily`), its energy on the
+    // Willmore rule's grid
+    let (us, wu) = crate::solid::gauss_legendre(16);
+    let vs: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
+    let family = FillFamily::new(&edges, &FillOptions { order: o.order, ..FillOptions::default() }, &us, &vs)?;
+    let ([fullness, height], willmore_energy) = fairest(|[f, h]| willmore(&family.grid2(f, h), &wu, vs.len()));
+    let fill = family.fill(fullness, height)?;
     if !fill.report().dropped_edges.is_empty() || !fill.report().split_edges.is_empty() {
         return Err(LoopFillError::Crease);
     }
@@ -536,38 +537,31 @@ fn zip(a: &[(f64, f64, u32)], b: &[(f64, f64, u32)], pos: &dyn Fn(u32) -> Vec3, 
 /// for a nearly flat surface `z(x, y)` it is `¼ ∫ (Δz)²`, whose minimisers (biharmonic
 /// `z`) include every quadratic — what a hole in a smooth surface should be filled with.
 /// `f` and `h` are what the G1/G2 conditions leave free to the fill's construction.
-#[allow(clippy::type_complexity)]
-fn fairest(
-    make: impl Fn([f64; 2]) -> Result<(Fill, f64), LoopFillError>,
-) -> Result<(Fill, [f64; 2], f64), LoopFillError> {
+fn fairest(energy: impl Fn([f64; 2]) -> f64) -> ([f64; 2], f64) {
     const BOUNDS: [(f64, f64); 2] = [(0.5, 2.0), (0.0, 4.0)];
     let mut x = [1.0, 1.0];
-    let (mut best, mut e) = make(x)?;
+    let mut e = energy(x);
     // NaN (a degenerate fill) never wins
     let better = |a: f64, b: f64| a < b || (b.is_nan() && !a.is_nan());
     let mut delta = [0.15, 0.4];
     for _round in 0..2 {
         for k in [1, 0] {
             let d = delta[k];
-            let at = |t: f64| -> Result<(f64, Fill), LoopFillError> {
+            let at = |t: f64| {
                 let mut y = x;
                 y[k] = t;
-                let (fill, energy) = make(y)?;
-                Ok((energy, fill))
+                energy(y)
             };
             let (lo, hi) = BOUNDS[k];
             let (xm, xp) = ((x[k] - d).max(lo), (x[k] + d).min(hi));
-            let (em, fm) = at(xm)?;
-            let (ep, fp) = at(xp)?;
-            let mut candidates = vec![(xm, em, fm), (xp, ep, fp)];
+            let (em, ep) = (at(xm), at(xp));
+            let mut candidates = vec![(xm, em), (xp, ep)];
             if let Some(t) = vertex(xm, x[k], xp, em, e, ep) {
                 let t = t.clamp(x[k] - 3.0 * d, x[k] + 3.0 * d).clamp(lo, hi);
-                let (et, ft) = at(t)?;
-                candidates.push((t, et, ft));
+                candidates.push((t, at(t)));
             }
-            for (t, et, ft) in candidates {
+            for (t, et) in candidates {
                 if better(et, e) {
-                    best = ft;
                     e = et;
                     x[k] = t;
                 }
@@ -575,7 +569,7 @@ fn fairest(
         }
         delta = delta.map(|d| d / 2.0);
     }
-    Ok((best, x, e))
+    (x, e)
 }
 
 /// The abscissa of the vertex of the parabola through `(a, fa)`, `(b, fb)`, `(c, fc)`
@@ -590,14 +584,12 @@ fn vertex(a: f64, b: f64, c: f64, fa: f64, fb: f64, fc: f64) -> Option<f64> {
     (opens_up && den != 0.0).then(|| b - ((b - a) * p - (b - c) * q) / den)
 }
 
-/// `∫ H² dA` over the patch (`u ∈ [0, 1]`, periodic `v`): `nu`-point Gauss–Legendre in
-/// `u`, the trapezoidal rule (spectrally accurate for periodic integrands) on `nv` points
-/// in `v`, with the exact first and second derivatives. `H = (L G − 2 M F + N E) / 2(EG −
-/// F²)`; points where `X_u × X_v` vanishes (the pole) carry no area.
-fn willmore(x: &dyn Surface, nu: usize, nv: usize) -> f64 {
-    let (us, wu) = crate::solid::gauss_legendre(nu);
-    let vs: Vec<f64> = (0..nv).map(|j| TAU * j as f64 / nv as f64).collect();
-    let g = x.grid2(&us, &vs);
+/// `∫ H² dA` over the patch (`u ∈ [0, 1]`, periodic `v`) from its exact first and second
+/// derivatives `g` on the grid of Gauss–Legendre nodes in `u` (weights `wu`) × `nv` even
+/// points in `v` (the trapezoidal rule, spectrally accurate for periodic integrands).
+/// `H = (L G − 2 M F + N E) / 2(EG − F²)`; points where `X_u × X_v` vanishes (the pole)
+/// carry no area.
+fn willmore(g: &[[Vec3; 6]], wu: &[f64], nv: usize) -> f64 {
     let mut sum = 0.0;
     for (i, w) in wu.iter().enumerate() {
         for j in 0..nv {
