@@ -883,9 +883,12 @@ impl Fill {
     /// of every edge (its start corner included), NaN-propagating.
     pub fn edge_continuity(&self, per_edge: usize) -> EdgeContinuity {
         let n = self.position.pieces.len();
+        let vs: Vec<f64> = (0..n * per_edge).map(|k| TAU * k as f64 / (n * per_edge) as f64).collect();
+        // the fill's side on one grid row (its work shared across the row)
+        let row = self.patch.grid2(&[0.0], &vs);
         let mut out = EdgeContinuity::default();
-        for k in 0..n * per_edge {
-            let p = self.edge_gaps_at(TAU * k as f64 / (n * per_edge) as f64);
+        for (d, &v) in row.iter().zip(&vs) {
+            let p = self.gaps(d, v);
             out.g1 = crate::num::max_nan(out.g1, p.g1);
             out.gap = crate::num::max_nan(out.gap, p.gap);
             out.g2 = crate::num::max_nan(out.g2, p.g2);
@@ -898,19 +901,25 @@ impl Fill {
     pub fn edge_gaps_at(&self, v: f64) -> EdgeContinuity {
         // index i·3 + j holds ∂uⁱ∂vʲ
         let d = self.patch.derivatives(0.0, v, 2, 2);
+        self.gaps(&[d[0], d[3], d[1], d[6], d[4], d[2]], v)
+    }
+
+    /// The measures at `v` from the fill's `[X, X_u, X_v, X_uu, X_uv, X_vv]` there.
+    fn gaps(&self, d: &[Vec3; 6], v: f64) -> EdgeContinuity {
+        let [x, xu, xv, xuu, xuv, xvv] = *d;
         let f = self.position.frame2(v, self.t);
         // both second fundamental forms against the fill's normal, in one orthonormal basis
         // of its tangent plane
         // a degenerate normal or tangent is NaN, so every measure there is NaN (not 0)
-        let nrm = d[3].cross(d[1]).normalized().unwrap_or(NAN3);
-        let e1 = d[1].normalized().unwrap_or(NAN3);
+        let nrm = xu.cross(xv).normalized().unwrap_or(NAN3);
+        let e1 = xv.normalized().unwrap_or(NAN3);
         let e2 = nrm.cross(e1);
-        let fill = second_form_in([d[3], d[1], d[6], d[4], d[2]], nrm, e1, e2);
+        let fill = second_form_in([xu, xv, xuu, xuv, xvv], nrm, e1, e2);
         let nb = second_form_in([f[1], f[2], f[3], f[4], f[5]], nrm, e1, e2);
         let diff = [[fill[0][0] - nb[0][0], fill[0][1] - nb[0][1]], [fill[1][0] - nb[1][0], fill[1][1] - nb[1][1]]];
         EdgeContinuity {
-            g1: line_angle(d[3].cross(d[1]), f[1].cross(f[2])),
-            gap: (d[0] - f[0]).norm() / self.report.radius,
+            g1: line_angle(xu.cross(xv), f[1].cross(f[2])),
+            gap: (x - f[0]).norm() / self.report.radius,
             g2: sym_norm(diff) * self.report.radius,
             samples: 1,
         }

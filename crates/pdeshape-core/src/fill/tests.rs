@@ -400,3 +400,22 @@ fn a_family_member_is_the_fill_of_its_fullness_and_height() {
         }
     }
 }
+
+/// `edge_continuity` reads the fill's side from one grid row, `edge_gaps_at` from the
+/// pointwise derivatives: the same measures. Compared on the order-4 fill of an uneven
+/// pentagon, whose curvature gap is of size 1 (order 4 does not match curvature).
+#[test]
+fn edge_continuity_on_a_grid_row_is_the_pointwise_measure() {
+    let fill = Fill::new(&sphere_loop(&[0.0, 1.1, 2.0, 3.4, 4.9], 0.7), &FillOptions::default()).unwrap();
+    let per = 40;
+    let row = fill.edge_continuity(per);
+    let mut g2 = 0.0;
+    for k in 0..5 * per {
+        g2 = crate::num::max_nan(g2, fill.edge_gaps_at(TAU * k as f64 / (5 * per) as f64).g2);
+    }
+    assert_eq!(row.samples, 5 * per);
+    assert!(g2 > 0.1, "{g2}");
+    // two exact evaluations of the same patch: round-off of ~1e-15 in second derivatives
+    assert!((row.g2 - g2).abs() < 1e-12 * g2, "{} against {g2}", row.g2);
+    assert!(row.g1 < 1e-13 && row.gap < 1e-13, "{row:?}");
+}
