@@ -119,7 +119,7 @@ impl FillFamily {
         for (w, g) in terms {
             for (o, x) in out.iter_mut().zip(g) {
                 for (a, b) in o.iter_mut().zip(x) {
-                    *a = *a + *b * w;
+                    *a += *b * w;
                 }
             }
         }
