@@ -123,9 +123,12 @@ pub enum LoopFillError {
         /// Loop length over median edge.
         ratio: f64,
     },
-    /// The fill found a crease in the collar or dropped a piece.
-    #[error("the collar has a crease or a piece without length")]
-    Crease,
+    /// The fill dropped a piece of the loop without length, or its mesh could not be
+    /// stitched to every loop edge.
+    #[error(
+        "the fill could not be stitched to the loop (a piece of the collar without length, or a loop edge left without a new triangle)"
+    )]
+    Unstitched,
 }
 
 /// Fills loop `lp` of `m`; the new vertices are numbered from `base`. Of the fills that
@@ -180,11 +183,15 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     // Willmore rule's grid
     let (us, wu) = crate::solid::gauss_legendre(16);
     let vs: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
-    let family = FillFamily::new(&edges, &FillOptions { order: o.order, ..FillOptions::default() }, &us, &vs)?;
+    // the collar (periodic cubic splines in `w`, a cubic in `s`) and the boundary line (a
+    // periodic cubic spline) are C2, so the reparametrised collar has no crease for
+    // `crease::creases` to look for (512 jets an edge)
+    let options = FillOptions { order: o.order, split_creases: false, ..FillOptions::default() };
+    let family = FillFamily::new(&edges, &options, &us, &vs)?;
     let ([fullness, height], willmore_energy) = fairest(|[f, h]| willmore(&family.grid2(f, h), &wu, vs.len()));
     let fill = family.fill(fullness, height)?;
     if !fill.report().dropped_edges.is_empty() || !fill.report().split_edges.is_empty() {
-        return Err(LoopFillError::Crease);
+        return Err(LoopFillError::Unstitched);
     }
     let folds = fill.folds(32, 64);
     if folds > 0 {
@@ -348,7 +355,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
             break;
         }
     }
-    let (positions, triangles) = made.ok_or(LoopFillError::Crease)?;
+    let (positions, triangles) = made.ok_or(LoopFillError::Unstitched)?;
     // measures: the seam's dihedral angles and the new edges' lengths
     let at = |i: u32| position(m, &positions, base, i);
     let normal = |t: &[u32; 3]| (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
@@ -368,7 +375,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     for (i, &tri) in on_loop.iter().enumerate() {
         let (a, b) = (lp.vertices[i], lp.vertices[(i + 1) % n]);
         let Some(ft) = fill_of.get(&(b, a)) else {
-            return Err(LoopFillError::Crease);
+            return Err(LoopFillError::Unstitched);
         };
         let (n1, n2) = (m.face_normal(tri), normal(ft));
         let ang = n1.cross(n2).norm().atan2(n1.dot(n2));
