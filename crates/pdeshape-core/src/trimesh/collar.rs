@@ -336,11 +336,13 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
     // 2. parameters: feet on the spine and signed distances
     let on_loop = triangles_on_loop(m, lp);
     let normal = normal_along(m, &on_loop, &chord, period, &us)?;
+    // the spine sampled once a loop vertex, for every vertex reached from it
+    let windows: Vec<Window> = (0..n).map(|k| Window::new(&spine, &chord, period, k, 3 + 2 * rings)).collect();
     let feet: Vec<(f64, f64, Vec3)> = pts
         .iter()
         .map(|&(v, k)| {
             let xv = m.positions[v as usize];
-            let w = foot(&spine, &chord, period, k, 3 + 2 * rings, xv);
+            let w = foot(&spine, &windows[k], period, xv);
             let j = spine.jet(&[w], JetShape::new(&[1]));
             let (pw, t) = (j.derivative([0, 0, 0]), j.derivative([1, 0, 0]));
             let d = xv - pw;
@@ -499,22 +501,42 @@ fn fit_curve(basis: &PeriodicSpline, data: impl Iterator<Item = (f64, Vec3)>) ->
     Ok(column(&sol, 0..c, 1.0))
 }
 
-/// The foot of `x` on the spine `p`: the nearest of 16 samples a loop edge within `reach`
-/// loop edges of vertex `k` (chord parameters `chord`), refined by Newton.
-fn foot(p: &NurbsCurve, chord: &[f64], period: f64, k: usize, reach: usize, x: Vec3) -> f64 {
-    let n = chord.len();
-    let at = |i: isize| -> f64 {
-        let kk = i.rem_euclid(n as isize) as usize;
-        chord[kk] + period * (i - kk as isize).div_euclid(n as isize) as f64
-    };
-    let reach = reach.min(n / 2) as isize;
-    let (lo, hi) = (at(k as isize - reach), at(k as isize + reach));
+/// The stretch of the spine `p` within `reach` loop edges of loop vertex `k` (chord
+/// parameters `chord`): its ends `lo`, `hi` (unwrapped) and 16 samples a loop edge, `(w, p(w))`.
+struct Window {
+    lo: f64,
+    hi: f64,
+    samples: Vec<(f64, Vec3)>,
+}
+
+impl Window {
+    fn new(p: &NurbsCurve, chord: &[f64], period: f64, k: usize, reach: usize) -> Self {
+        let n = chord.len();
+        let at = |i: isize| -> f64 {
+            let kk = i.rem_euclid(n as isize) as usize;
+            chord[kk] + period * (i - kk as isize).div_euclid(n as isize) as f64
+        };
+        let reach = reach.min(n / 2) as isize;
+        let (lo, hi) = (at(k as isize - reach), at(k as isize + reach));
+        let count = 16 * reach as usize;
+        let samples = (0..=count)
+            .map(|i| {
+                let w = lo + (hi - lo) * i as f64 / count as f64;
+                (w, p.eval(&[w.rem_euclid(period)]))
+            })
+            .collect();
+        Window { lo, hi, samples }
+    }
+}
+
+/// The foot of `x` on the spine `p`: the nearest of the window's samples, refined by Newton
+/// within the window.
+fn foot(p: &NurbsCurve, win: &Window, period: f64, x: Vec3) -> f64 {
+    let (lo, hi) = (win.lo, win.hi);
     let wrap = |w: f64| w.rem_euclid(period);
     let mut best = (f64::INFINITY, lo);
-    let samples = 16 * reach as usize;
-    for i in 0..=samples {
-        let w = lo + (hi - lo) * i as f64 / samples as f64;
-        let d = (p.eval(&[wrap(w)]) - x).norm();
+    for &(w, pw) in &win.samples {
+        let d = (pw - x).norm();
         if d < best.0 {
             best = (d, w);
         }
