@@ -336,13 +336,13 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
     // 2. parameters: feet on the spine and signed distances
     let on_loop = triangles_on_loop(m, lp);
     let normal = normal_along(m, &on_loop, &chord, period, &us)?;
-    // the spine sampled once a loop vertex, for every vertex reached from it
-    let windows: Vec<Window> = (0..n).map(|k| Window::new(&spine, &chord, period, k, 3 + 2 * rings)).collect();
+    // the spine sampled once, for every vertex's foot
+    let samples = SpineSamples::new(&spine, &chord, period);
     let feet: Vec<(f64, f64, Vec3)> = pts
         .iter()
         .map(|&(v, k)| {
             let xv = m.positions[v as usize];
-            let w = foot(&spine, &windows[k], period, xv);
+            let w = foot(&spine, &samples, k, 3 + 2 * rings, xv);
             let j = spine.jet(&[w], JetShape::new(&[1]));
             let (pw, t) = (j.derivative([0, 0, 0]), j.derivative([1, 0, 0]));
             let d = xv - pw;
@@ -501,41 +501,54 @@ fn fit_curve(basis: &PeriodicSpline, data: impl Iterator<Item = (f64, Vec3)>) ->
     Ok(column(&sol, 0..c, 1.0))
 }
 
-/// The stretch of the spine `p` within `reach` loop edges of loop vertex `k` (chord
-/// parameters `chord`): its ends `lo`, `hi` (unwrapped) and 16 samples a loop edge, `(w, p(w))`.
-struct Window {
-    lo: f64,
-    hi: f64,
+/// The spine `p` sampled at [`SpineSamples::PER_EDGE`] points a loop edge, evenly in each
+/// edge's chord interval: where every foot search starts.
+struct SpineSamples {
+    period: f64,
+    /// `(w, p(w))` for `w` in `[0, period)`, increasing.
     samples: Vec<(f64, Vec3)>,
 }
 
-impl Window {
-    fn new(p: &NurbsCurve, chord: &[f64], period: f64, k: usize, reach: usize) -> Self {
+impl SpineSamples {
+    const PER_EDGE: usize = 8;
+
+    fn new(p: &NurbsCurve, chord: &[f64], period: f64) -> Self {
         let n = chord.len();
-        let at = |i: isize| -> f64 {
-            let kk = i.rem_euclid(n as isize) as usize;
-            chord[kk] + period * (i - kk as isize).div_euclid(n as isize) as f64
-        };
-        let reach = reach.min(n / 2) as isize;
-        let (lo, hi) = (at(k as isize - reach), at(k as isize + reach));
-        let count = 16 * reach as usize;
-        let samples = (0..=count)
-            .map(|i| {
-                let w = lo + (hi - lo) * i as f64 / count as f64;
-                (w, p.eval(&[w.rem_euclid(period)]))
+        let samples = (0..n)
+            .flat_map(|e| {
+                let (a, b) = (chord[e], if e + 1 < n { chord[e + 1] } else { chord[0] + period });
+                (0..Self::PER_EDGE).map(move |i| a + (b - a) * i as f64 / Self::PER_EDGE as f64)
             })
+            .map(|w| (w, p.eval(&[w.rem_euclid(period)])))
             .collect();
-        Window { lo, hi, samples }
+        SpineSamples { period, samples }
+    }
+
+    /// The samples within `reach` loop edges of loop vertex `k` (at most half the loop each
+    /// way), their `w` unwrapped to increase through `chord[k]`: the window's ends `lo`,
+    /// `hi` and its samples.
+    fn window(&self, k: usize, reach: usize) -> (f64, f64, impl Iterator<Item = (f64, Vec3)> + '_) {
+        let n = self.samples.len() / Self::PER_EDGE;
+        let reach = reach.min(n / 2) as isize;
+        let count = self.samples.len() as isize;
+        let at = move |j: isize| -> (f64, Vec3) {
+            let (w, pw) = self.samples[j.rem_euclid(count) as usize];
+            (w + self.period * j.div_euclid(count) as f64, pw)
+        };
+        let per = Self::PER_EDGE as isize;
+        let (first, last) = ((k as isize - reach) * per, (k as isize + reach) * per);
+        (at(first).0, at(last).0, (first..=last).map(at))
     }
 }
 
-/// The foot of `x` on the spine `p`: the nearest of the window's samples, refined by Newton
-/// within the window.
-fn foot(p: &NurbsCurve, win: &Window, period: f64, x: Vec3) -> f64 {
-    let (lo, hi) = (win.lo, win.hi);
+/// The foot of `x` on the spine `p`: the nearest of the samples within `reach` loop edges of
+/// loop vertex `k`, refined by Newton within them.
+fn foot(p: &NurbsCurve, samples: &SpineSamples, k: usize, reach: usize, x: Vec3) -> f64 {
+    let period = samples.period;
+    let (lo, hi, window) = samples.window(k, reach);
     let wrap = |w: f64| w.rem_euclid(period);
     let mut best = (f64::INFINITY, lo);
-    for &(w, pw) in &win.samples {
+    for (w, pw) in window {
         let d = (pw - x).norm();
         if d < best.0 {
             best = (d, w);
