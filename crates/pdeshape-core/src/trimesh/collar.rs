@@ -40,7 +40,7 @@ use super::{MeshLoop, PeriodicSpline, TriMesh};
 use crate::Vec3;
 use crate::data::{Field, NurbsCurve, VecJet};
 use crate::jet::{Jet, JetShape};
-use crate::linalg::{LinalgError, SquareSolver};
+use crate::linalg::{LinalgError, SpdSolver};
 use crate::num::max_nan;
 use faer::Mat;
 use std::cmp::Ordering;
@@ -268,7 +268,8 @@ fn penalised_fit(
             }
         }
     }
-    let solver = SquareSolver::new(&g, 1e13)?;
+    // `g` is symmetric positive definite where the fit is determined
+    let solver = SpdSolver::new(&g, 1e13)?;
     Ok((solver.solve(&r), solver.cond()))
 }
 
