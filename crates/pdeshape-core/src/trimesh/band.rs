@@ -29,7 +29,12 @@
 //! one, on the notch's bisector at `ℓ̄ cos(α/2)` from the vertex, where (for equal edges)
 //! each edge sees it at a right angle. Sharpest notches first, an edge in one pair only.
 //!
-//! **Junctions.** Where two neighbouring apexes still come closer than `h / 2`, or the
+//! **Lengths.** The mesh's density asks for new edges within 2× of the local median edge
+//! length `h_l` (the median at a loop vertex and its two neighbours): no apex is nearer
+//! than `SHORTEST · h_l` to a loop vertex of its triangles (its height is raised where a
+//! short loop edge would put it nearer) or to the next apex.
+//!
+//! **Junctions.** Where two neighbouring apexes still come closer than `SHORTEST · h_l`, or the
 //! triangle between them at their shared loop vertex turns over, their edges share one
 //! apex (over their chord, high enough to clear the vertex between), at most
 //! `MOST_MERGED` edges to an apex. At a loop vertex where the loop turns towards the mesh
@@ -61,12 +66,19 @@ const NOTCH: f64 = 135.0 * PI / 180.0;
 /// The most loop edges that share one apex.
 const MOST_MERGED: usize = 2;
 
-/// A vertex of the band: its position and its collar parameters `(s, w)`.
+/// The shortest edge from an apex (to a loop vertex or to another apex), as a fraction of
+/// the local median edge length: the mesh's density asks for new edges within 2× of it,
+/// and this keeps a margin above the half.
+pub(super) const SHORTEST: f64 = 0.55;
+
+/// A vertex of the band: its position, its collar parameters `(s, w)` and the local
+/// median edge length `h` of the loop vertices it stands over.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BandVertex {
     pub p: Vec3,
     pub s: f64,
     pub w: f64,
+    pub h: f64,
 }
 
 /// The band: its vertices in order along the loop and its triangles, on the loop's
@@ -77,7 +89,8 @@ pub(super) struct Band {
 }
 
 /// What the band is built from: the loop's vertex ids, positions and collar parameters
-/// (`w` increasing within one period), the collar and its period, and `h`.
+/// (`w` increasing within one period), the collar and its period, `h` and the local
+/// median edge length at each loop vertex.
 pub(super) struct BandInput<'a> {
     pub ids: &'a [u32],
     pub pos: &'a [Vec3],
@@ -85,6 +98,7 @@ pub(super) struct BandInput<'a> {
     pub collar: &'a Collar,
     pub period: f64,
     pub h: f64,
+    pub local: &'a [f64],
 }
 
 /// `C`, `C_s`, `C_w` at `(s, w)`.
@@ -124,7 +138,7 @@ fn point_on_collar(c: &Collar, planes: [(Vec3, Vec3, f64); 2], start: (f64, f64)
         // the residual is a length: done at round-off of the collar's size
         if f[0].abs().max(f[1].abs()) <= 1e-13 * (1.0 + p.max_abs()) {
             let p = c.eval(&[s, w]);
-            return Some(BandVertex { p, s, w });
+            return Some(BandVertex { p, s, w, h: 0.0 });
         }
     }
     None
@@ -148,6 +162,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         (s, w + inp.period * (k / n) as f64)
     };
     let x = |k: usize| inp.pos[k % n];
+    let hl = |k: usize| inp.local[k % n];
     // the collar's unit normal at each loop vertex, once
     let normals: Vec<Option<Vec3>> = inp.params.iter().map(|&(s, w)| collar_normal(inp.collar, s, w)).collect();
     let vn = |k: usize| normals[k % n];
@@ -163,12 +178,17 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         let mid = (0.5 * (pa.0 + pb.0), 0.5 * (pa.1 + pb.1));
         let n0 = collar_normal(inp.collar, mid.0, mid.1)?;
         let q = t.cross(n0).normalized()?;
-        // over the highest loop vertex between, by 0.4 of an edge
-        let above = (a + 1..b).map(|k| (x(k) - m).dot(q) + 0.4 * mean).fold(0.0, crate::num::max_nan);
-        let height = crate::num::max_nan(BAND_HEIGHT * mean, above);
+        // over the highest loop vertex between, by 0.4 of an edge and `SHORTEST` of the
+        // local median
+        let floor = SHORTEST * hl(a).max(hl(b));
+        let above = (a + 1..b).map(|k| (x(k) - m).dot(q) + (0.4 * mean).max(floor)).fold(0.0, crate::num::max_nan);
+        // the legs from x(a) and x(b), √((c/2)² + H²), no shorter than `floor`
+        let half = 0.5 * chord.norm();
+        let legs = (floor * floor - half * half).max(0.0).sqrt();
+        let height = crate::num::max_nan(crate::num::max_nan(BAND_HEIGHT * mean, above), legs);
         let [_, cs, _] = collar_first(inp.collar, mid.0, mid.1);
         let start = (mid.0 - height / cs.norm().max(1e-300), mid.1);
-        point_over(inp.collar, m, t, height, start, reach)
+        point_over(inp.collar, m, t, height, start, reach).map(|v| BandVertex { h: hl(a).max(hl(b)), ..v })
     };
     // the shared apex of edges a and a + 1 at a notch of hole-side angle α at x = x(a+1):
     // on the notch's bisector `b` (in the plane of `b` and the normal) at `ℓ̄ cos(α/2)`
@@ -182,10 +202,19 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         let b = (u0 + u1).normalized()?;
         let side = b.cross(nrm).normalized()?;
         let half = 0.5 * u0.cross(u1).norm().atan2(u0.dot(u1));
-        let l = 0.5 * ((x(a + 1) - x(a)).norm() + (x(a + 2) - x(a + 1)).norm());
-        let r = l * half.cos();
+        let (l0, l1) = ((x(a + 1) - x(a)).norm(), (x(a + 2) - x(a + 1)).norm());
+        // no nearer any of the three vertices than `SHORTEST` of the local median `F`: at a
+        // wide notch (α → 135°) ℓ̄ cos(α/2) falls to 0.38 ℓ̄ (the circumcentres then lie
+        // 0.06 ℓ̄ beyond the edges instead of on them), and beside a short edge of length
+        // ℓ its far vertex lies √(ℓ² + r² − 2ℓr cos(α/2)) from the apex, at least `F` for
+        // r ≥ ℓ cos(α/2) + √(F² − ℓ² sin²(α/2))
+        let f = SHORTEST * hl(a).max(hl(a + 1)).max(hl(a + 2));
+        let (c, sn) = (half.cos(), half.sin());
+        let clear = |l: f64| l * c + (f * f - l * l * sn * sn).max(0.0).sqrt();
+        let r = [f, clear(l0), clear(l1)].into_iter().fold(0.5 * (l0 + l1) * c, crate::num::max_nan);
         let cs = collar_first(inp.collar, pv.0, pv.1)[1].norm().max(1e-300);
         point_on_collar(inp.collar, [(xv, side, 0.0), (xv, b, r)], (pv.0 - r / cs, pv.1), reach)
+            .map(|b| BandVertex { h: hl(a + 1), ..b })
     };
     // does the triangle (p, q, r) face the collar's normal at loop vertex `v`?
     let faces = |p: Vec3, q: Vec3, r: Vec3, v: usize| -> bool {
@@ -266,7 +295,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
             // a reflex fan at a peak of the loop is split below; elsewhere it has turned over
             let open = faces(x(v), a.2.p, b.2.p, v) || (peak(v) && (PI - 0.35..=1.6 * PI).contains(&phi));
             let bad = if open { d } else { -1.0 };
-            if bad < 0.5 * h && !(bad >= 0.0 && kept[v]) && worst.is_none_or(|w| bad < w.1) {
+            if bad < SHORTEST * hl(v) && !(bad >= 0.0 && kept[v]) && worst.is_none_or(|w| bad < w.1) {
                 worst = Some((j, bad));
             }
         }
@@ -312,14 +341,15 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
             let pv = param(v);
             let split = t.and_then(|t| {
                 let cs = collar_first(inp.collar, pv.0, pv.1)[1].norm().max(1e-300);
-                let height = BAND_HEIGHT * 0.5 * (e0 + e1);
+                let height = (BAND_HEIGHT * 0.5 * (e0 + e1)).max(SHORTEST * hl(v));
                 point_over(inp.collar, xv, t, height, (pv.0 - height / cs, pv.1), reach)
+                    .map(|b| BandVertex { h: hl(v), ..b })
             });
             if let Some(b) = split.filter(|b| {
                 faces(xv, prev.p, b.p, v)
                     && faces(xv, b.p, ap.p, v)
-                    && (b.p - prev.p).norm() >= 0.5 * h
-                    && (b.p - ap.p).norm() >= 0.5 * h
+                    && (b.p - prev.p).norm() >= SHORTEST * hl(v)
+                    && (b.p - ap.p).norm() >= SHORTEST * hl(v)
             }) {
                 vertices.push(b);
                 split_id[j] = Some(base + vertices.len() as u32 - 1);
