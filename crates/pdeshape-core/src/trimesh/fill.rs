@@ -202,7 +202,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     let family = FillFamily::new(&edges, &options, &us, &vs)?;
     let ([fullness, height], willmore_energy) = fairest(|[f, h]| willmore(&family.grid2(f, h), &wu, vs.len()));
     let fill = family.fill(fullness, height)?;
-    if !fill.report().dropped_edges.is_empty() || !fill.report().split_edges.is_empty() {
+    if !fill.report().dropped_edges.is_empty() {
         return Err(LoopFillError::Unstitched);
     }
     let folds = fill.folds(32, 64);
