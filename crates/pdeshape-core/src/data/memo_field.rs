@@ -7,7 +7,7 @@
 
 use super::{Field, FieldRef, VecJet};
 use crate::Vec3;
-use crate::jet::JetShape;
+use crate::jet::{Jet, JetShape};
 use crate::memo::BoundedMemo;
 use std::sync::Arc;
 
@@ -23,12 +23,27 @@ pub struct MemoField {
     inner: FieldRef,
     memo: BoundedMemo<Key, Arc<[Vec3]>>,
     jets: BoundedMemo<JetKey, Arc<VecJet>>,
+    /// With [`MemoField::covering`]: jets of shapes within this one are cut from the
+    /// point's jet of this shape.
+    cover: Option<JetShape>,
 }
 
 impl MemoField {
     /// Wraps `inner`.
     pub fn new(inner: FieldRef) -> Self {
-        MemoField { inner, memo: BoundedMemo::new(16_384), jets: BoundedMemo::new(16_384) }
+        MemoField { inner, memo: BoundedMemo::new(16_384), jets: BoundedMemo::new(16_384), cover: None }
+    }
+
+    /// Wraps `inner`, whose jets are asked at the same points in many shapes within
+    /// `cover` (a fill's solves ask its boundary data for values, first and second cross
+    /// derivatives, each with its own number of derivatives along the loop): a point's jet
+    /// is computed once, in shape `cover`, and the smaller ones are its Taylor
+    /// coefficients within theirs. A jet's coefficient of a multi-index is a sum over
+    /// smaller multi-indices only, so it does not depend on the shape it was computed in
+    /// beyond the order of that sum's terms: round-off. The shape computed does not
+    /// depend on the order of the requests (nor on threads).
+    pub fn covering(inner: FieldRef, cover: JetShape) -> Self {
+        MemoField { cover: Some(cover), ..MemoField::new(inner) }
     }
 }
 
@@ -51,15 +66,34 @@ impl Field for MemoField {
             *b = x.to_bits();
         }
         // a different number of slots at the same values is another point of another field
-        let key = ([bits[0], bits[1], bits[2] ^ ((at.len() as u64) << 60)], shape);
-        if let Some(j) = self.jets.get(&key) {
+        let point = [bits[0], bits[1], bits[2] ^ ((at.len() as u64) << 60)];
+        let asked = shape.orders();
+        let computed = match self.cover {
+            Some(c) if c.orders().iter().zip(&asked).all(|(c, a)| a <= c) => c,
+            _ => shape,
+        };
+        let key = (point, computed);
+        let j = match self.jets.get(&key) {
+            Some(j) => j,
+            None => {
+                let j = Arc::new(self.inner.jet(at, computed));
+                self.jets.insert(key, j.clone());
+                j
+            }
+        };
+        if computed == shape {
             return (*j).clone();
         }
-        let j = self.inner.jet(at, shape);
-        self.jets.insert(key, Arc::new(j.clone()));
-        j
+        VecJet(std::array::from_fn(|k| {
+            Jet::from_coeffs(shape, shape.multi_indices().map(|m| j.0[k].coeff(m)).collect())
+        }))
     }
     fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+        // covering: through the point's one jet (the inner field's default answers from
+        // its jet of this shape as well)
+        if self.cover.is_some() && at.len() <= 3 {
+            return super::derivatives_by_jet(self, at, slot, out);
+        }
         // only the slots a key holds (later slots would be ignored by it)
         if at.len() > 2 {
             return self.inner.derivatives_in(at, slot, out);
@@ -131,5 +165,45 @@ mod tests {
             }
         }
         assert_eq!(inner.1.load(Ordering::Relaxed), 10, "each jet asked once per point and shape");
+    }
+
+    /// Covering: each point's jet computed once, in the covering shape; smaller shapes and
+    /// derivatives along a slot cut from it agree with the inner field's own to round-off,
+    /// and a shape beyond the cover is the inner field's own.
+    #[test]
+    fn covering_cuts_smaller_jets_from_one() {
+        let e = ExprField::parse(["cos(3*v)*exp(t)", "sin(v)*t*t", "v*v/(1+t*t)"], &["v", "t"], &|_| None).unwrap();
+        let inner = Arc::new(Counted(e.clone(), AtomicUsize::new(0)));
+        let m = MemoField::covering(inner.clone(), JetShape::new(&[2, 3]));
+        let points = [[0.1, 0.5], [0.7, -0.2], [2.0, 1.3]];
+        for _ in 0..2 {
+            for at in points {
+                for orders in [[0, 0], [1, 1], [2, 2], [0, 3], [2, 3], [1, 0]] {
+                    let shape = JetShape::new(&orders);
+                    let (a, b) = (m.jet(&at, shape), e.jet(&at, shape));
+                    for k in 0..3 {
+                        assert_eq!(a.0[k].shape(), shape);
+                        for (x, y) in a.0[k].coeffs().iter().zip(b.0[k].coeffs()) {
+                            // the same Taylor arithmetic, its sums cut at another shape:
+                            // round-off of coefficients of size ~10
+                            assert!((x - y).abs() <= 1e-14 * (1.0 + y.abs()), "{at:?} {orders:?}: {x} {y}");
+                        }
+                    }
+                }
+                for slot in [0, 1] {
+                    let (mut a, mut b) = (vec![Vec3::ZERO; 3], vec![Vec3::ZERO; 3]);
+                    m.derivatives_in(&at, slot, &mut a);
+                    e.derivatives_in(&at, slot, &mut b);
+                    for (x, y) in a.iter().zip(&b) {
+                        assert!((*x - *y).norm() <= 1e-13 * (1.0 + y.norm()), "{at:?} slot {slot}: {x:?} {y:?}");
+                    }
+                }
+            }
+        }
+        assert_eq!(inner.1.load(Ordering::Relaxed), points.len(), "one jet a point");
+        // beyond the cover: the inner field's own, bit for bit
+        let big = JetShape::new(&[3, 1]);
+        assert_eq!(m.jet(&points[0], big), e.jet(&points[0], big));
+        assert_eq!(inner.1.load(Ordering::Relaxed), points.len() + 1);
     }
 }

@@ -180,7 +180,10 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         curve: DomainCurve::Field(Arc::new(line.clone())),
     };
     // the fills of several fullnesses ask the collar at the same points: kept per point
-    let surface: FieldRef = Arc::new(crate::data::MemoField::new(Arc::new(along)));
+    // and each in several shapes: orders 4 and 6 ask for up to 2 derivatives across and
+    // up to 3 and 4 along (seen), so a point's jet is computed once in that shape
+    let cover = crate::jet::JetShape::new(&[2, o.order / 2 + 1]);
+    let surface: FieldRef = Arc::new(crate::data::MemoField::covering(Arc::new(along), cover));
     // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
     let edges: Vec<FillEdge> = (0..4)
         .map(|k| FillEdge {
