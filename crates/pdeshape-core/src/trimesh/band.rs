@@ -30,7 +30,8 @@
 //! each edge sees it at a right angle. Sharpest notches first, an edge in one pair only.
 //!
 //! **Lengths.** The mesh's density asks for new edges within 2× of the local median edge
-//! length `h_l` (the median at a loop vertex and its two neighbours): no apex is nearer
+//! length `h_l` (the median of the mesh's edges at a loop vertex and at its neighbours):
+//! no apex is nearer
 //! than `SHORTEST · h_l` to a loop vertex of its triangles (its height is raised where a
 //! short loop edge would put it nearer) or to the next apex.
 //!
@@ -49,6 +50,7 @@ use super::collar::Collar;
 use crate::Vec3;
 use crate::data::Field;
 use crate::jet::JetShape;
+use crate::num::max_nan;
 use std::f64::consts::PI;
 
 /// The apex's height over its edge, as a fraction of the edge's length: just above 0.5,
@@ -180,15 +182,15 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         let q = t.cross(n0).normalized()?;
         // over the highest loop vertex between, by 0.4 of an edge and `SHORTEST` of the
         // local median
-        let floor = SHORTEST * hl(a).max(hl(b));
-        let above = (a + 1..b).map(|k| (x(k) - m).dot(q) + (0.4 * mean).max(floor)).fold(0.0, crate::num::max_nan);
+        let floor = SHORTEST * max_nan(hl(a), hl(b));
+        let above = (a + 1..b).map(|k| (x(k) - m).dot(q) + max_nan(0.4 * mean, floor)).fold(0.0, max_nan);
         // the legs from x(a) and x(b), √((c/2)² + H²), no shorter than `floor`
         let half = 0.5 * chord.norm();
-        let legs = (floor * floor - half * half).max(0.0).sqrt();
-        let height = crate::num::max_nan(crate::num::max_nan(BAND_HEIGHT * mean, above), legs);
+        let legs = max_nan(floor * floor - half * half, 0.0).sqrt();
+        let height = max_nan(max_nan(BAND_HEIGHT * mean, above), legs);
         let [_, cs, _] = collar_first(inp.collar, mid.0, mid.1);
         let start = (mid.0 - height / cs.norm().max(1e-300), mid.1);
-        point_over(inp.collar, m, t, height, start, reach).map(|v| BandVertex { h: hl(a).max(hl(b)), ..v })
+        point_over(inp.collar, m, t, height, start, reach).map(|v| BandVertex { h: max_nan(hl(a), hl(b)), ..v })
     };
     // the shared apex of edges a and a + 1 at a notch of hole-side angle α at x = x(a+1):
     // on the notch's bisector `b` (in the plane of `b` and the normal) at `ℓ̄ cos(α/2)`
@@ -208,10 +210,10 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
         // 0.06 ℓ̄ beyond the edges instead of on them), and beside a short edge of length
         // ℓ its far vertex lies √(ℓ² + r² − 2ℓr cos(α/2)) from the apex, at least `F` for
         // r ≥ ℓ cos(α/2) + √(F² − ℓ² sin²(α/2))
-        let f = SHORTEST * hl(a).max(hl(a + 1)).max(hl(a + 2));
+        let f = SHORTEST * max_nan(max_nan(hl(a), hl(a + 1)), hl(a + 2));
         let (c, sn) = (half.cos(), half.sin());
-        let clear = |l: f64| l * c + (f * f - l * l * sn * sn).max(0.0).sqrt();
-        let r = [f, clear(l0), clear(l1)].into_iter().fold(0.5 * (l0 + l1) * c, crate::num::max_nan);
+        let clear = |l: f64| l * c + max_nan(f * f - l * l * sn * sn, 0.0).sqrt();
+        let r = [f, clear(l0), clear(l1)].into_iter().fold(0.5 * (l0 + l1) * c, max_nan);
         let cs = collar_first(inp.collar, pv.0, pv.1)[1].norm().max(1e-300);
         point_on_collar(inp.collar, [(xv, side, 0.0), (xv, b, r)], (pv.0 - r / cs, pv.1), reach)
             .map(|b| BandVertex { h: hl(a + 1), ..b })
@@ -341,7 +343,7 @@ pub(super) fn apex_band(inp: &BandInput, base: u32) -> Option<Band> {
             let pv = param(v);
             let split = t.and_then(|t| {
                 let cs = collar_first(inp.collar, pv.0, pv.1)[1].norm().max(1e-300);
-                let height = (BAND_HEIGHT * 0.5 * (e0 + e1)).max(SHORTEST * hl(v));
+                let height = max_nan(BAND_HEIGHT * 0.5 * (e0 + e1), SHORTEST * hl(v));
                 point_over(inp.collar, xv, t, height, (pv.0 - height / cs, pv.1), reach)
                     .map(|b| BandVertex { h: hl(v), ..b })
             });

@@ -313,7 +313,7 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
                 // local median is left out (never three neighbours): the band's vertices
                 // lie unevenly close to the boundary
                 let near = |p: Vec3| {
-                    band.is_some_and(|b| b.vertices.iter().any(|v| (v.p - p).norm() < (0.4 * h).max(SHORTEST * v.h)))
+                    band.is_some_and(|b| b.vertices.iter().any(|v| (v.p - p).norm() < max_nan(0.4 * h, SHORTEST * v.h)))
                 };
                 let mut keep = vec![true; pts.len()];
                 for k in 0..pts.len() {
@@ -456,7 +456,7 @@ fn boundary_line(fit: &CollarFit, h: f64, band: &[BandVertex]) -> DomainLine {
     let over = fit.params.iter().fold(f64::NEG_INFINITY, |a, &(s, w)| max_nan(a, line.sigma(w) - (s - 0.4 * h)));
     let over = band
         .iter()
-        .fold(over, |a, b| max_nan(a, line.sigma(b.w) - (b.s - (BAND_CLEAR * h).max(BAND_CLEAR_LOCAL * b.h))));
+        .fold(over, |a, b| max_nan(a, line.sigma(b.w) - (b.s - max_nan(BAND_CLEAR * h, BAND_CLEAR_LOCAL * b.h))));
     if over > 0.0 {
         // a spline's values shift with its control points (partition of unity)
         ctrl.iter_mut().for_each(|c| *c -= over);
