@@ -1,5 +1,5 @@
 //! The holes of a triangle mesh: listed (a typed report for `holes` and its JSON), and
-//! filled — each simple loop by [`pdeshape_core::trimesh::fill_loop`] — with the new
+//! filled — each simple loop by [`pdeshape_core::trimesh::fill_loop_with`] — with the new
 //! vertices and triangles appended to the mesh (every input vertex and triangle kept, in
 //! its place) and written in the format the output's extension names.
 
@@ -11,7 +11,7 @@ use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
 use pdeshape_core::trimesh::{
-    LoopFillOptions, LoopKind, MeshLoop, TriMesh, crossings, dihedral_angles, fill_loop, quantile,
+    LoopFillOptions, LoopKind, MeshLoop, TriMesh, adjacency, crossings, dihedral_angles, fill_loop_with, quantile,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -152,9 +152,10 @@ pub fn fill_mesh_holes(
     let mut owner: Vec<(usize, usize)> = Vec::new();
     let mut reports = Vec::with_capacity(chosen.len());
     let lo = LoopFillOptions { order: o.order, max_vertices: limits.vertices, ..Default::default() };
+    let adj = adjacency(&mf.mesh);
     for i in chosen {
         // each loop's collar is fitted to the input mesh: fills do not see each other
-        let f = fill_loop(&mf.mesh, &loops[i], out.positions.len() as u32, &lo)
+        let f = fill_loop_with(&mf.mesh, &adj, &loops[i], out.positions.len() as u32, &lo)
             .map_err(|e| format!("hole {}: {e}", i + 1))?;
         reports.push(MeshFillReport {
             index: i + 1,

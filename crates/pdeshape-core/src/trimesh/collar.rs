@@ -608,8 +608,16 @@ pub(super) fn triangles_on_loop(m: &TriMesh, lp: &MeshLoop) -> Vec<usize> {
     let n = lp.vertices.len();
     let mut want: std::collections::HashMap<(u32, u32), usize> =
         (0..n).map(|i| ((lp.vertices[i], lp.vertices[(i + 1) % n]), i)).collect();
+    // only a triangle with a loop vertex can run a loop edge: the hash asked for those alone
+    let mut on = vec![false; m.positions.len()];
+    for &v in &lp.vertices {
+        on[v as usize] = true;
+    }
     let mut out = vec![usize::MAX; n];
     for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
+        if !(on[a as usize] || on[b as usize] || on[c as usize]) {
+            continue;
+        }
         for e in [(a, b), (b, c), (c, a)] {
             if let Some(i) = want.remove(&e) {
                 out[i] = t;

@@ -139,6 +139,18 @@ pub enum LoopFillError {
 /// meet the collar G1 (G2), differing in the length of their cross tangent and the height
 /// of their pole, the one of least Willmore energy is taken (`fairest`).
 pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> Result<LoopFill, LoopFillError> {
+    fill_loop_with(m, &adjacency(m), lp, base, o)
+}
+
+/// [`fill_loop`] with the mesh's [`adjacency`] given: a mesh with several holes builds it
+/// once (a pass over every triangle; it was three a hole).
+pub fn fill_loop_with(
+    m: &TriMesh,
+    adj: &[Vec<u32>],
+    lp: &MeshLoop,
+    base: u32,
+    o: &LoopFillOptions,
+) -> Result<LoopFill, LoopFillError> {
     if lp.kind == LoopKind::TouchesItself {
         return Err(LoopFillError::NotSimple);
     }
@@ -147,23 +159,33 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
         return Err(LoopFillError::TooShort(n));
     }
     let original = (m, lp);
-    let h = median_edge(m, &adjacency(m), lp);
+    let h = median_edge(m, adj, lp);
     // the loop's sharp notches closed first, by triangles on its own vertices
-    let (ears, clipped) = clip_ears(m, lp, h);
+    let (ears, clipped) = clip_ears(m, adj, lp, h);
     let with_ears;
-    let (m, lp) = if ears.is_empty() {
-        (m, lp)
+    let (m, lp, adj) = if ears.is_empty() {
+        (m, lp, std::borrow::Cow::Borrowed(adj))
     } else {
         let mut w = m.clone();
         w.triangles.extend(&ears);
+        // an ear `[c, b, a]` adds the edge `a c`; `b a` and `c b` are the loop's own
+        let mut wadj = adj.to_vec();
+        for &[c, _, a] in &ears {
+            for (x, y) in [(a, c), (c, a)] {
+                let l = &mut wadj[x as usize];
+                if let Err(k) = l.binary_search(&y) {
+                    l.insert(k, y);
+                }
+            }
+        }
         with_ears = (w, MeshLoop { vertices: clipped, ..lp.clone() });
-        (&with_ears.0, &with_ears.1)
+        (&with_ears.0, &with_ears.1, std::borrow::Cow::Owned(wadj))
     };
-    let adj = adjacency(m);
-    let fit = fit_collar(m, &adj, lp, o.rings)?;
+    let adj: &[Vec<u32>] = &adj;
+    let fit = fit_collar(m, adj, lp, o.rings)?;
     let (period, w0) = (fit.period, fit.params[0].1);
     let loop_pos: Vec<Vec3> = lp.vertices.iter().map(|&v| m.positions[v as usize]).collect();
-    let local = local_medians(m, &adj, &lp.vertices);
+    let local = local_medians(m, adj, &lp.vertices);
     let band_input = BandInput {
         ids: &lp.vertices,
         pos: &loop_pos,
@@ -247,11 +269,14 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     let mut plan = Vec::with_capacity(rings);
     // ring 0 and the band have fewer than 2 vertices a loop vertex
     let mut count = 2.0 * n as f64;
-    for j in 0..rings {
-        let u = if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) };
-        let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
-        let pts = patch.grid(&[u], &around);
-        let perim: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).norm()).sum();
+    // the rings' perimeters from one grid: the patch's data at each `v` once
+    let ring_us: Vec<f64> =
+        (0..rings).map(|j| if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) }).collect();
+    let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
+    let ring_pts = patch.grid_values(&ring_us, &around);
+    for (j, &u) in ring_us.iter().enumerate() {
+        let pts = &ring_pts[j * around.len()..(j + 1) * around.len()];
+        let perim: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
         let nj_f = (perim / h).round();
         if j > 0 {
             count += nj_f;
@@ -381,10 +406,19 @@ pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> 
     let mut seam_dihedral: f64 = 0.0;
     let mut edge_ratio = (f64::INFINITY, 0.0f64);
     let mut fill_of = std::collections::HashMap::new();
-    // the local median at the loop vertex nearest a point
+    // the local median at the loop vertex nearest a point (the first of equals; squared
+    // distances order the vertices as distances do)
     let local_at = |p: Vec3| {
-        let near = (0..loop_pos.len()).min_by(|&i, &j| (loop_pos[i] - p).norm().total_cmp(&(loop_pos[j] - p).norm()));
-        near.map_or(h, |i| local[i])
+        let mut near = (f64::INFINITY, h);
+        for (q, &l) in loop_pos.iter().zip(&local) {
+            let e = *q - p;
+            let d = e.dot(e);
+            if d < near.0 {
+                near = (d, l);
+            }
+        }
+        // a point without a nearest vertex (NaN) has a NaN ratio through its length
+        near.1
     };
     for t in &triangles {
         for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
@@ -469,7 +503,7 @@ fn boundary_line(fit: &CollarFit, h: f64, band: &[BandVertex]) -> DomainLine {
 /// the triangle on its two edges (the loop then runs straight from one neighbour to the
 /// other); never two neighbouring vertices in one pass, two passes, at least four vertices
 /// left. Returns the triangles and the loop that remains.
-fn clip_ears(m: &TriMesh, lp: &MeshLoop, h: f64) -> (Vec<[u32; 3]>, Vec<u32>) {
+fn clip_ears(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, h: f64) -> (Vec<[u32; 3]>, Vec<u32>) {
     let on_loop = triangles_on_loop(m, lp);
     let mut verts: Vec<(u32, Vec3)> = lp
         .vertices
@@ -482,7 +516,6 @@ fn clip_ears(m: &TriMesh, lp: &MeshLoop, h: f64) -> (Vec<[u32; 3]>, Vec<u32>) {
             (v, nrm)
         })
         .collect();
-    let adj = adjacency(m);
     let mut ears = Vec::new();
     for _ in 0..2 {
         let n = verts.len();
