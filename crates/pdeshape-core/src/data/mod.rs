@@ -127,6 +127,19 @@ pub trait Field: Send + Sync + Debug {
     fn expressions(&self) -> Option<(&[crate::expr::Expr; 3], &[String])> {
         None
     }
+
+    /// `Some(d)` when the field is proved, from how it is built, a trigonometric polynomial
+    /// of degree at most `d` in slot 0 that does not depend on its other slots; `None` when
+    /// nothing is known. Expression fields are analysed ([`crate::expr::trig_degree`]);
+    /// other fields say so themselves (a fill's ring `c + ρ (e₁ cos v + e₂ sin v)` has
+    /// degree 1). A spectral patch with `M ≥ d` takes such a datum's Fourier tails as zero.
+    fn trig_degree(&self) -> Option<usize> {
+        let (comps, vars) = self.expressions()?;
+        comps.iter().try_fold(0, |acc, e| {
+            let free = (1..vars.len()).all(|i| !e.depends_on(i));
+            free.then(|| crate::expr::trig_degree(e, 0)).flatten().map(|d| acc.max(d))
+        })
+    }
 }
 
 /// [`Field::derivatives_in`] through a jet of order `out.len() − 1` in `slot`.

@@ -57,22 +57,26 @@ impl FillFamily {
         let solve = |c: &[Condition]| SpectralPatch::new(c, VDomain::PERIODIC, o.spectral);
         let rule = BendingRule::new(setup.edges);
         // the loop's data one at a time, the pole's at zero
-        let mut loop_rows = Vec::new();
-        let mut loop_grids = Vec::new();
-        for k in 0..setup.conds.len() {
-            let mut c = zero_loop.clone();
-            c[k] = setup.conds[k].clone();
-            let p = solve(&setup.with_pole(&zero, &c, o.order))?;
-            loop_rows.push(rule.rows(&p));
-            loop_grids.push(p.grid2(us, vs));
-        }
-        let mut unit_rows = Vec::new();
-        let mut unit_grids = Vec::new();
-        for d in unit_poles(&free) {
-            let p = solve(&setup.with_pole(&d, &zero_loop, o.order))?;
-            unit_rows.push(rule.rows(&p));
-            unit_grids.push(p.grid2(us, vs));
-        }
+        let loop_patches = (0..setup.conds.len())
+            .map(|k| {
+                let mut c = zero_loop.clone();
+                c[k] = setup.conds[k].clone();
+                solve(&setup.with_pole(&zero, &c, o.order))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let unit_patches = unit_poles(&free)
+            .iter()
+            .map(|d| solve(&setup.with_pole(d, &zero_loop, o.order)))
+            .collect::<Result<Vec<_>, _>>()?;
+        // the members differ in their data alone: their cardinal functions evaluated once a
+        // `u` of the rule and of the grid
+        let all: Vec<&SpectralPatch> = loop_patches.iter().chain(&unit_patches).collect();
+        SpectralPatch::share_rows(&all, &rule.us, 2);
+        SpectralPatch::share_rows(&all, us, 2);
+        let loop_rows: Vec<Vec<Vec3>> = loop_patches.iter().map(|p| rule.rows(p)).collect();
+        let loop_grids = loop_patches.iter().map(|p| p.grid2(us, vs)).collect();
+        let unit_rows: Vec<Vec<Vec3>> = unit_patches.iter().map(|p| rule.rows(p)).collect();
+        let unit_grids = unit_patches.iter().map(|p| p.grid2(us, vs)).collect();
         let coeffs = bending_solve(&unit_rows, &loop_rows)?;
         Ok(FillFamily {
             edges: edges.to_vec(),

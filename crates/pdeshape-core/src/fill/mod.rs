@@ -235,6 +235,13 @@ impl Field for Ring {
     fn is_constant_in(&self, slot: usize) -> bool {
         slot == 1
     }
+    /// `c + ρ (e₁ cos v + e₂ sin v)`: degree 1 (0 without the circle), not depending on time.
+    fn trig_degree(&self) -> Option<usize> {
+        let finite =
+            [self.centre, self.e1, self.e2].iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
+        (finite && self.rho.is_finite())
+            .then(|| usize::from(self.rho != 0.0 && (self.e1 != Vec3::ZERO || self.e2 != Vec3::ZERO)))
+    }
     /// `∂ᵏ/∂vᵏ = ρ (e₁ cos(v + kπ/2) + e₂ sin(v + kπ/2))` (plus the centre at `k = 0`).
     fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
         let v = at[0];

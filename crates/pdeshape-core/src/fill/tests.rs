@@ -419,3 +419,16 @@ fn edge_continuity_on_a_grid_row_is_the_pointwise_measure() {
     assert!((row.g2 - g2).abs() < 1e-12 * g2, "{} against {g2}", row.g2);
     assert!(row.g1 < 1e-13 && row.gap < 1e-13, "{row:?}");
 }
+
+/// The pole's ring is a trigonometric polynomial of degree 1 (0 without its circle) by
+/// construction, so spectral patches skip its Fourier tails; a ring that is not finite is
+/// not proved anything.
+#[test]
+fn the_pole_ring_is_a_trigonometric_polynomial() {
+    let ring = |rho: f64, e1: Vec3| Ring { centre: Vec3::new(1.0, 2.0, 3.0), e1, e2: Vec3::new(0.0, 1.0, 0.0), rho };
+    assert_eq!(ring(0.5, Vec3::new(1.0, 0.0, 0.0)).trig_degree(), Some(1));
+    assert_eq!(ring(0.0, Vec3::new(1.0, 0.0, 0.0)).trig_degree(), Some(0));
+    assert_eq!(zero_field().trig_degree(), Some(0));
+    assert_eq!(ring(f64::NAN, Vec3::new(1.0, 0.0, 0.0)).trig_degree(), None);
+    assert_eq!(ring(0.5, Vec3::new(f64::INFINITY, 0.0, 0.0)).trig_degree(), None);
+}

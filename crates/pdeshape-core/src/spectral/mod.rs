@@ -110,16 +110,16 @@ pub struct SpectralPatch {
     /// round-off (which the remainder's cardinal functions amplify: 6e-14 relative in the
     /// dolphin's flukes' `X_u`), and does not evaluate the data at all.
     exact_series: bool,
+    /// The same of each datum: its tails are zero and are not evaluated (the members of a
+    /// fill family have most of their data zero or the pole's ring).
+    exact: Vec<bool>,
 }
 
-/// Whether the datum `g(θ, t)` is an expression field proved a trigonometric polynomial of
-/// degree at most `modes` in θ that does not depend on `t` (the series is analysed at one
-/// time).
+/// Whether the datum `g(θ, t)` is proved a trigonometric polynomial of degree at most
+/// `modes` in θ that does not depend on `t` ([`Field::trig_degree`]; the series is analysed
+/// at one time).
 fn finite_series(g: &FieldRef, modes: usize) -> bool {
-    let Some((comps, vars)) = g.expressions() else { return false };
-    comps.iter().all(|e| {
-        (1..vars.len()).all(|i| !e.depends_on(i)) && crate::expr::trig_degree(e, 0).is_some_and(|d| d <= modes)
-    })
+    g.trig_degree().is_some_and(|d| d <= modes)
 }
 
 /// The modes' cardinal sets and the remainder's.
@@ -278,6 +278,7 @@ impl SpectralPatch {
             time: 0.0,
             cache: BoundedMemo::new(4096),
             folded: OnceLock::new(),
+            exact: data.iter().map(|d| domain.periodic && finite_series(d, opts.modes)).collect(),
             exact_series: domain.periodic && data.iter().all(|d| finite_series(d, opts.modes)),
             data,
         })
@@ -349,22 +350,55 @@ impl SpectralPatch {
         if let Some(r) = self.cache.get(&key) {
             return r;
         }
+        let (cards, rem) = self.sets(k);
+        let modes: Vec<Vec<Vec<f64>>> = cards.iter().map(|card| card.eval(u, k)).collect();
+        let row = Arc::new(self.row_from(&modes, rem.eval(u, k), k));
+        self.cache.insert(key, row.clone());
+        row
+    }
+
+    /// The row at `u` from each mode's cardinal functions `modes[mode][kk][i] = ℓ_i^{(kk)}(u)`
+    /// and the remainder's `l`: the modes folded with the data's Fourier coefficients.
+    fn row_from(&self, modes: &[Vec<Vec<f64>>], l: Vec<Vec<f64>>, k: usize) -> Row {
         let m = self.opts.modes;
         let mut a = vec![vec![Vec3::ZERO; m + 1]; k + 1];
         let mut b = vec![vec![Vec3::ZERO; m + 1]; k + 1];
-        let (cards, rem) = self.sets(k);
-        for (mode, card) in cards.iter().enumerate() {
-            let l = card.eval(u, k);
-            for (kk, lk) in l.iter().enumerate() {
+        for (mode, lm) in modes.iter().enumerate() {
+            for (kk, lk) in lm.iter().enumerate() {
                 for (i, s) in self.series.iter().enumerate() {
                     a[kk][mode] += s.a[mode] * lk[i];
                     b[kk][mode] += s.b[mode] * lk[i];
                 }
             }
         }
-        let row = Arc::new(Row { a, b, l: rem.eval(u, k) });
-        self.cache.insert(key, row.clone());
-        row
+        Row { a, b, l }
+    }
+
+    /// Fills the row caches of `patches` at every `u` of `us` (derivatives to `k`) from one
+    /// evaluation of the cardinal functions a `u`. Patches solved for the same conditions'
+    /// places and orders, `a`, `M` and `ω` share their cardinal sets (process-wide) and differ
+    /// in their data alone — the members of a fill family; a patch whose sets are not the
+    /// first's is left to compute its own rows. The rows are those [`row`](Self::row)
+    /// computes, bit for bit (the same sums in the same order).
+    pub fn share_rows(patches: &[&SpectralPatch], us: &[f64], k: usize) {
+        let Some(first) = patches.first() else { return };
+        let (cards, rem) = first.sets(k);
+        let same = |p: &SpectralPatch| {
+            let (c, r) = p.sets(k);
+            Arc::ptr_eq(r, rem) && c.len() == cards.len() && c.iter().zip(cards).all(|(x, y)| Arc::ptr_eq(x, y))
+        };
+        let sharing: Vec<&SpectralPatch> = patches.iter().copied().filter(|p| same(p)).collect();
+        for &u in us {
+            let key = (u.to_bits(), k);
+            if sharing.iter().all(|p| p.cache.get(&key).is_some()) {
+                continue;
+            }
+            let modes: Vec<Vec<Vec<f64>>> = cards.iter().map(|card| card.eval(u, k)).collect();
+            let l = rem.eval(u, k);
+            for p in &sharing {
+                p.cache.insert(key, Arc::new(p.row_from(&modes, l.clone(), k)));
+            }
+        }
     }
 
     /// `(cos nθ, sin nθ)` for `n = 0 … M`.
@@ -385,7 +419,11 @@ impl SpectralPatch {
         self.data
             .iter()
             .zip(&self.series)
-            .map(|(g, s)| {
+            .zip(&self.exact)
+            .map(|((g, s), &exact)| {
+                if exact {
+                    return vec![Vec3::ZERO; jmax + 1];
+                }
                 let mut d = vec![Vec3::ZERO; jmax + 1];
                 g.derivatives_in(&[theta, self.time], 0, &mut d);
                 let series = s.derivatives_from(cs, jmax);

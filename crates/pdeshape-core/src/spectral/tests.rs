@@ -310,4 +310,28 @@ fn data_proved_finite_series_have_no_remainder() {
         assert!(!r.exact_series, "{x}");
     }
     assert!(SpectralPatch::new(&with("cos(4*v)"), VDomain::PERIODIC, opts).unwrap().exact_series);
+
+    // proved data beside opaque ones: the proved data's tails are zero and not evaluated,
+    // the others' summed, and the patch equals the all-opaque one to round-off
+    let mixed: Vec<Condition> = ends
+        .iter()
+        .map(|&(u, d)| Condition { u, order: d, data: if d == 0 { expr_data(u, d) } else { data_of(exact(a), u, d) } })
+        .collect();
+    let r = SpectralPatch::new(&mixed, VDomain::PERIODIC, opts).unwrap();
+    assert!(!r.exact_series);
+    assert_eq!(r.exact, [true, false, true, false]);
+    let mut apart: f64 = 0.0;
+    for j in 0..30 {
+        let th = j as f64 * 0.21;
+        let tails = r.tails(th, 2);
+        assert!(tails[0].iter().chain(&tails[2]).all(|t| *t == Vec3::ZERO), "θ = {th}");
+        for i in 0..=20 {
+            let u = i as f64 / 20.0;
+            for (x, y) in r.derivatives(u, th, 1, 1).iter().zip(&q.derivatives(u, th, 1, 1)) {
+                apart = crate::num::max_nan(apart, (*x - *y).norm());
+            }
+        }
+    }
+    // as above: a few ulps of values and derivatives ≤ 10
+    assert!(apart < 1e-13, "mixed and opaque data differ by {apart:e}");
 }
