@@ -40,7 +40,7 @@ use super::{MeshLoop, PeriodicSpline, TriMesh};
 use crate::Vec3;
 use crate::data::{Field, NurbsCurve, VecJet};
 use crate::jet::{Jet, JetShape};
-use crate::linalg::{LinalgError, SpdSolver};
+use crate::linalg::{LinalgError, ProfileCholesky};
 use crate::num::max_nan;
 use faer::Mat;
 use std::cmp::Ordering;
@@ -178,7 +178,8 @@ pub struct CollarFit {
     /// The largest `|C(s_i, w_i) − x_i|` at the loop's vertices' parameters (the fit's
     /// residual, and the shift of the feet that `loop_parameters` moved forward).
     pub loop_residual: f64,
-    /// 2-norm condition number of the least-squares normal matrix.
+    /// The least-squares normal matrix's 1-norm condition number, estimated
+    /// ([`ProfileCholesky`]; the 2-norm one is at most this and at least this over its order).
     pub cond: f64,
 }
 
@@ -237,29 +238,36 @@ pub fn adjacency(m: &TriMesh) -> Vec<Vec<u32>> {
 
 /// Solves the penalised normal equations `(AᵀA + λ D) X = Aᵀ B` of a periodic spline fit:
 /// `rows` gives each data row's non-zero columns and values and its right-hand side.
+/// Column `k m + j` (block `k`, control point `j` of `m`) is unknown `j · blocks + k`: so
+/// ordered, a row's columns (four neighbouring control points in every block) and the
+/// penalty's (three in one block) lie within a band of `4 · blocks` but for the control
+/// points that wrap round, and the envelope Cholesky ([`ProfileCholesky`]) costs
+/// `O(n · blocks²)` where the dense one and the symmetric eigenvalues cost `O(n³)`. The
+/// condition number returned is the estimated 1-norm one.
 fn penalised_fit(
     nc: usize,
     blocks: usize,
     rows: impl Iterator<Item = (Vec<(usize, f64)>, Vec3)>,
 ) -> Result<(Mat<f64>, f64), LinalgError> {
+    let m = nc / blocks;
+    let at = |c: usize| (c % m) * blocks + c / m;
     let mut g = Mat::<f64>::zeros(nc, nc);
     let mut r = Mat::<f64>::zeros(nc, 3);
     for (cols, d) in rows {
         for &(ca, va) in &cols {
             for &(cb, vb) in &cols {
-                g[(ca, cb)] += va * vb;
+                g[(at(ca), at(cb))] += va * vb;
             }
             for c in 0..3 {
-                r[(ca, c)] += va * d[c];
+                r[(at(ca), c)] += va * d[c];
             }
         }
     }
     let trace: f64 = (0..nc).map(|i| g[(i, i)]).sum::<f64>() / nc as f64;
     let lambda = 1e-6 * trace;
-    let m = nc / blocks;
     for k in 0..blocks {
         for j in 0..m {
-            let idx = [(j + m - 1) % m, j, (j + 1) % m].map(|i| k * m + i);
+            let idx = [(j + m - 1) % m, j, (j + 1) % m].map(|i| at(k * m + i));
             let coef = [1.0, -2.0, 1.0];
             for a in 0..3 {
                 for b in 0..3 {
@@ -269,8 +277,9 @@ fn penalised_fit(
         }
     }
     // `g` is symmetric positive definite where the fit is determined
-    let solver = SpdSolver::new(&g, 1e13)?;
-    Ok((solver.solve(&r), solver.cond()))
+    let solver = ProfileCholesky::new(&g, 1e13)?;
+    let x = solver.solve(&r);
+    Ok((Mat::from_fn(nc, 3, |c, k| x[(at(c), k)]), solver.cond()))
 }
 
 fn column(sol: &Mat<f64>, range: std::ops::Range<usize>, scale: f64) -> Vec<Vec3> {

@@ -21,7 +21,23 @@ pub enum LinalgError {
     /// The singular value decomposition did not converge.
     #[error("the singular value decomposition did not converge")]
     NoConvergence,
+    /// The matrix is singular to working precision by its estimated 1-norm condition
+    /// number ([`ProfileCholesky`]).
+    #[error("the system is singular (1-norm condition number estimated at {cond:.3e})")]
+    SingularEstimate {
+        /// The estimate.
+        cond: f64,
+    },
+    /// A Cholesky factorisation met a pivot that is not positive.
+    #[error("the system is not positive definite to working precision (row {row})")]
+    NotPositiveDefinite {
+        /// The row where the pivot was not positive.
+        row: usize,
+    },
 }
+
+mod profile;
+pub use profile::ProfileCholesky;
 
 /// The 2-norm condition number `σ_max / σ_min` of a matrix (∞ for a rank-deficient one).
 pub fn condition_number(a: &Mat<f64>) -> Result<f64, LinalgError> {
@@ -167,6 +183,16 @@ pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<
 /// many matrices and rarely below a third of the true value (Higham, "Accuracy and
 /// Stability of Numerical Algorithms", §15.3). NaN in, NaN out.
 pub fn inverse_norm1_estimate(lu: &impl Solve<f64>, n: usize) -> f64 {
+    inverse_norm1_estimate_by(n, |b| lu.solve(b), |b| lu.solve_transpose(b))
+}
+
+/// [`inverse_norm1_estimate`] with the solves with `A` and `Aᵀ` given (a factorization
+/// that is not one of faer's).
+pub fn inverse_norm1_estimate_by(
+    n: usize,
+    solve: impl Fn(&Mat<f64>) -> Mat<f64>,
+    solve_transpose: impl Fn(&Mat<f64>) -> Mat<f64>,
+) -> f64 {
     if n == 0 {
         return 0.0;
     }
@@ -175,7 +201,7 @@ pub fn inverse_norm1_estimate(lu: &impl Solve<f64>, n: usize) -> f64 {
     let mut est = f64::NAN;
     let mut last_j = usize::MAX;
     for iter in 0..5 {
-        let y = lu.solve(&x);
+        let y = solve(&x);
         let ny = norm1(&y);
         if !ny.is_finite() {
             return ny;
@@ -185,7 +211,7 @@ pub fn inverse_norm1_estimate(lu: &impl Solve<f64>, n: usize) -> f64 {
         }
         est = ny;
         let xi = Mat::<f64>::from_fn(n, 1, |i, _| if y[(i, 0)] >= 0.0 { 1.0 } else { -1.0 });
-        let z = lu.solve_transpose(&xi);
+        let z = solve_transpose(&xi);
         let (mut j, mut zj) = (0, f64::NEG_INFINITY);
         for i in 0..n {
             if z[(i, 0)].abs() > zj {
@@ -205,7 +231,7 @@ pub fn inverse_norm1_estimate(lu: &impl Solve<f64>, n: usize) -> f64 {
         let s = if i % 2 == 0 { 1.0 } else { -1.0 };
         s * (1.0 + i as f64 / (n.max(2) - 1) as f64)
     });
-    let extra = 2.0 * norm1(&lu.solve(&alt)) / (3.0 * n as f64);
+    let extra = 2.0 * norm1(&solve(&alt)) / (3.0 * n as f64);
     crate::num::max_nan(est, extra)
 }
 
