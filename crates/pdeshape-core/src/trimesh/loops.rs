@@ -125,36 +125,101 @@ impl LoopKind {
     }
 }
 
+/// The half-edges of a mesh's first triangles, by tail vertex: `(head, triangle)` for every
+/// directed edge `tail → head` a triangle runs, in triangle order. A vertex has a handful,
+/// so looking one up scans a few entries where a hash map of all the mesh's half-edges
+/// hashed each (three passes of it were most of reading a mesh).
+pub(super) struct HalfEdges {
+    start: Vec<usize>,
+    out: Vec<(u32, usize)>,
+}
+
+impl HalfEdges {
+    /// Of `m.triangles[..count]`, whose indices must be in range.
+    pub(super) fn new(m: &TriMesh, count: usize) -> HalfEdges {
+        let tris = &m.triangles[..count];
+        let mut start = vec![0usize; m.positions.len() + 1];
+        for t in tris {
+            for &v in t {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for i in 0..m.positions.len() {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut out = vec![(0u32, 0usize); start[m.positions.len()]];
+        for (t, &[a, b, c]) in tris.iter().enumerate() {
+            for (x, y) in [(a, b), (b, c), (c, a)] {
+                out[fill[x as usize]] = (y, t);
+                fill[x as usize] += 1;
+            }
+        }
+        HalfEdges { start, out }
+    }
+
+    /// The half-edges leaving `x`, in triangle order.
+    pub(super) fn from(&self, x: u32) -> &[(u32, usize)] {
+        &self.out[self.start[x as usize]..self.start[x as usize + 1]]
+    }
+
+    /// The first triangle before `before` that runs `x → y`.
+    fn first(&self, x: u32, y: u32, before: usize) -> Option<usize> {
+        self.from(x).iter().find(|&&(h, t)| h == y && t < before).map(|&(_, t)| t)
+    }
+
+    /// Whether any triangle runs `x → y`.
+    fn has(&self, x: u32, y: u32) -> bool {
+        self.from(x).iter().any(|&(h, _)| h == y)
+    }
+}
+
 /// Checks that `m` is an oriented 2-manifold with boundary and returns its boundary loops
 /// (longest first is not implied: in the order their first half-edges appear).
+///
+/// The first triangle (in order) with something wrong is reported: its own faults (an
+/// index out of range, a repeated vertex, no area) before those it has with the triangles
+/// before it (the same three vertices, an edge run twice the same way, or by a third).
 pub fn boundary(m: &TriMesh) -> Result<Vec<MeshLoop>, TopologyError> {
     let nv = m.positions.len();
     if let Some(vertex) = m.positions.iter().position(|p| !p.is_finite()) {
         return Err(TopologyError::NonFinite { vertex });
     }
-    let mut half: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * m.triangles.len());
-    let mut sets: HashMap<[u32; 3], usize> = HashMap::with_capacity(m.triangles.len());
-    for (t, tri) in m.triangles.iter().enumerate() {
+    // the first triangle faulty on its own; the half-edges of those before it
+    let own = m.triangles.iter().enumerate().find_map(|(t, tri)| {
         if let Some(&index) = tri.iter().find(|&&i| i as usize >= nv) {
-            return Err(TopologyError::IndexOutOfRange { triangle: t, index, count: nv });
+            return Some(TopologyError::IndexOutOfRange { triangle: t, index, count: nv });
         }
         let [a, b, c] = *tri;
         if a == b || b == c || a == c {
-            return Err(TopologyError::Degenerate { triangle: t, why: "a repeated vertex" });
+            return Some(TopologyError::Degenerate { triangle: t, why: "a repeated vertex" });
         }
-        if m.face_normal(t) == Vec3::ZERO {
-            return Err(TopologyError::Degenerate { triangle: t, why: "zero area" });
-        }
+        (m.face_normal(t) == Vec3::ZERO).then_some(TopologyError::Degenerate { triangle: t, why: "zero area" })
+    });
+    let count = match &own {
+        Some(TopologyError::IndexOutOfRange { triangle, .. } | TopologyError::Degenerate { triangle, .. }) => *triangle,
+        _ => m.triangles.len(),
+    };
+    let half = HalfEdges::new(m, count);
+    for (t, tri) in m.triangles[..count].iter().enumerate() {
+        let [a, b, c] = *tri;
         let mut key = *tri;
         key.sort_unstable();
-        if let Some(&first) = sets.get(&key) {
+        // an earlier triangle on the same three vertices runs an edge of this one
+        let same = |&(h, s): &(u32, usize)| {
+            s < t && tri.contains(&h) && {
+                let mut k = m.triangles[s];
+                k.sort_unstable();
+                k == key
+            }
+        };
+        if let Some(first) = tri.iter().flat_map(|&v| half.from(v).iter().filter(|e| same(e))).map(|e| e.1).min() {
             return Err(TopologyError::Duplicate { triangle: t, first });
         }
-        sets.insert(key, t);
         for (x, y) in [(a, b), (b, c), (c, a)] {
-            if let Some(&first) = half.get(&(x, y)) {
+            if let Some(first) = half.first(x, y, t) {
                 // a third triangle on an edge run both ways already is non-manifold
-                if let Some(&other) = half.get(&(y, x)) {
+                if let Some(other) = half.first(y, x, t) {
                     return Err(TopologyError::NonManifold {
                         a: x.min(y),
                         b: x.max(y),
@@ -163,28 +228,26 @@ pub fn boundary(m: &TriMesh) -> Result<Vec<MeshLoop>, TopologyError> {
                 }
                 return Err(TopologyError::Orientation { a: x, b: y, first, second: t });
             }
-            half.insert((x, y), t);
         }
+    }
+    if let Some(e) = own {
+        return Err(e);
     }
     // more than two triangles on one undirected edge shows as both directions taken and a
     // third use; caught above. Boundary half-edges: those whose twin is missing.
     let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &(x, y) in half.keys() {
-        if !half.contains_key(&(y, x)) {
-            out.entry(x).or_default().push(y);
-        }
-    }
-    for v in out.values_mut() {
-        v.sort_unstable();
-    }
     let mut starts: Vec<(usize, u32, u32)> = Vec::new();
     for (t, tri) in m.triangles.iter().enumerate() {
         let [a, b, c] = *tri;
         for (x, y) in [(a, b), (b, c), (c, a)] {
-            if !half.contains_key(&(y, x)) {
+            if !half.has(y, x) {
                 starts.push((t, x, y));
+                out.entry(x).or_default().push(y);
             }
         }
+    }
+    for v in out.values_mut() {
+        v.sort_unstable();
     }
     let mut used: HashMap<(u32, u32), bool> = HashMap::new();
     let mut loops = Vec::new();
@@ -260,21 +323,20 @@ fn classify(m: &TriMesh, loops: &mut [MeshLoop]) {
 /// The angle (radians) between the normals of the two triangles of every interior edge,
 /// with the edge, NaN where a triangle has no normal.
 pub fn dihedral_angles(m: &TriMesh) -> Vec<((u32, u32), f64)> {
-    let mut half: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * m.triangles.len());
-    for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
-        for e in [(a, b), (b, c), (c, a)] {
-            half.insert(e, t);
-        }
-    }
+    let half = HalfEdges::new(m, m.triangles.len());
     let mut out = Vec::new();
-    for (&(x, y), &t) in &half {
-        if x < y
-            && let Some(&s) = half.get(&(y, x))
-        {
-            let (n1, n2) = (m.face_normal(t), m.face_normal(s));
-            let c = n1.dot(n2) / (n1.norm() * n2.norm());
-            let sn = n1.cross(n2).norm() / (n1.norm() * n2.norm());
-            out.push(((x, y), sn.atan2(c)));
+    for x in 0..m.positions.len() as u32 {
+        for &(y, t) in half.from(x) {
+            // the last triangle of each direction, should an edge be run twice one way
+            if x < y
+                && half.from(x).iter().rev().find(|e| e.0 == y).map(|e| e.1) == Some(t)
+                && let Some(&(_, s)) = half.from(y).iter().rev().find(|e| e.0 == x)
+            {
+                let (n1, n2) = (m.face_normal(t), m.face_normal(s));
+                let c = n1.dot(n2) / (n1.norm() * n2.norm());
+                let sn = n1.cross(n2).norm() / (n1.norm() * n2.norm());
+                out.push(((x, y), sn.atan2(c)));
+            }
         }
     }
     out.sort_by_key(|e| e.0);

@@ -353,3 +353,132 @@ fn collar_does_not_depend_on_the_loops_first_vertex() {
     eprintln!("{offs:?}");
     assert!(hi < 3e-3 && hi < 2.0 * lo, "{offs:?}");
 }
+
+/// The hash-map form `boundary` and `dihedral_angles` had before they read half-edges by
+/// vertex: the oracle of `topology_agrees_with_the_hash_map_form` (its errors and its
+/// boundary half-edges; the loops are chained from those by shared code).
+mod hash_reference {
+    use super::super::{TopologyError, TriMesh};
+    use crate::Vec3;
+    use std::collections::HashMap;
+
+    pub fn check(m: &TriMesh) -> Result<Vec<(u32, u32)>, TopologyError> {
+        let nv = m.positions.len();
+        if let Some(vertex) = m.positions.iter().position(|p| !p.is_finite()) {
+            return Err(TopologyError::NonFinite { vertex });
+        }
+        let mut half: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut sets: HashMap<[u32; 3], usize> = HashMap::new();
+        for (t, tri) in m.triangles.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i as usize >= nv) {
+                return Err(TopologyError::IndexOutOfRange { triangle: t, index, count: nv });
+            }
+            let [a, b, c] = *tri;
+            if a == b || b == c || a == c {
+                return Err(TopologyError::Degenerate { triangle: t, why: "a repeated vertex" });
+            }
+            if m.face_normal(t) == Vec3::ZERO {
+                return Err(TopologyError::Degenerate { triangle: t, why: "zero area" });
+            }
+            let mut key = *tri;
+            key.sort_unstable();
+            if let Some(&first) = sets.get(&key) {
+                return Err(TopologyError::Duplicate { triangle: t, first });
+            }
+            sets.insert(key, t);
+            for (x, y) in [(a, b), (b, c), (c, a)] {
+                if let Some(&first) = half.get(&(x, y)) {
+                    if let Some(&other) = half.get(&(y, x)) {
+                        return Err(TopologyError::NonManifold {
+                            a: x.min(y),
+                            b: x.max(y),
+                            triangles: vec![first, other, t],
+                        });
+                    }
+                    return Err(TopologyError::Orientation { a: x, b: y, first, second: t });
+                }
+                half.insert((x, y), t);
+            }
+        }
+        let mut open: Vec<(u32, u32)> = half.keys().filter(|&&(x, y)| !half.contains_key(&(y, x))).copied().collect();
+        open.sort_unstable();
+        Ok(open)
+    }
+
+    pub fn dihedral_angles(m: &TriMesh) -> Vec<((u32, u32), f64)> {
+        let mut half: HashMap<(u32, u32), usize> = HashMap::new();
+        for (t, &[a, b, c]) in m.triangles.iter().enumerate() {
+            for e in [(a, b), (b, c), (c, a)] {
+                half.insert(e, t);
+            }
+        }
+        let mut out = Vec::new();
+        for (&(x, y), &t) in &half {
+            if x < y
+                && let Some(&s) = half.get(&(y, x))
+            {
+                let (n1, n2) = (m.face_normal(t), m.face_normal(s));
+                let c = n1.dot(n2) / (n1.norm() * n2.norm());
+                let sn = n1.cross(n2).norm() / (n1.norm() * n2.norm());
+                out.push(((x, y), sn.atan2(c)));
+            }
+        }
+        out.sort_by_key(|e| e.0);
+        out
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+
+    /// Meshes with holes, damaged in random places (a triangle turned over, repeated,
+    /// given a fin, an index out of range, a repeated vertex, a vertex moved onto another,
+    /// a NaN), are judged as the hash-map form judged them: the same first error, or the
+    /// same boundary half-edges and the same dihedral angles, bit for bit.
+    #[test]
+    fn topology_agrees_with_the_hash_map_form(
+        level in 0usize..2,
+        cut in 0.2f64..0.9,
+        damage in proptest::collection::vec((0usize..7, 0usize..10_000, 0usize..10_000), 0..4),
+    ) {
+        let mut m = cut_cap(&icosphere(level + 1), Vec3::new(0.3, 0.5, 0.8), cut);
+        for (kind, i, j) in damage {
+            let (nt, nv) = (m.triangles.len(), m.positions.len());
+            let (t, s) = (i % nt, j % nt);
+            match kind {
+                0 => m.triangles[t].swap(1, 2),
+                1 => { let x = m.triangles[t]; m.triangles.push(x) }
+                2 => { let [a, b, _] = m.triangles[t]; m.positions.push(Vec3::new(0.1, 0.2, 3.0)); m.triangles.push([a, b, nv as u32]) }
+                3 => m.triangles[t][j % 3] = (nv + i % 3) as u32,
+                4 => m.triangles[t][1] = m.triangles[t][0],
+                5 => {
+                    // a vertex moved onto another (indices an earlier damage put out of range left alone)
+                    let (v, w) = (m.triangles[s][0] as usize, m.triangles[t][1] as usize);
+                    if v < nv && w < nv {
+                        m.positions[w] = m.positions[v];
+                    }
+                }
+                _ => m.positions[j % nv].x = f64::NAN,
+            }
+        }
+        let got = boundary(&m);
+        let want = hash_reference::check(&m);
+        match (&got, &want) {
+            (Err(a), Err(b)) => proptest::prop_assert_eq!(a, b),
+            (Ok(loops), Ok(open)) => {
+                let mut ours: Vec<(u32, u32)> = loops
+                    .iter()
+                    .flat_map(|l| (0..l.vertices.len()).map(move |k| (l.vertices[k], l.vertices[(k + 1) % l.vertices.len()])))
+                    .collect();
+                ours.sort_unstable();
+                proptest::prop_assert_eq!(&ours, open);
+                let (d, r) = (dihedral_angles(&m), hash_reference::dihedral_angles(&m));
+                proptest::prop_assert_eq!(d.len(), r.len());
+                for (x, y) in d.iter().zip(&r) {
+                    proptest::prop_assert!(x.0 == y.0 && x.1.to_bits() == y.1.to_bits(), "{:?} {:?}", x, y);
+                }
+            }
+            _ => proptest::prop_assert!(false, "ours {:?}, the hash map's {:?}", got.as_ref().map(|l| l.len()), want.as_ref().map(|l| l.len())),
+        }
+    }
+}
