@@ -11,7 +11,8 @@ use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
 use pdeshape_core::trimesh::{
-    LoopFillOptions, LoopKind, MeshLoop, TriMesh, adjacency, crossings, dihedral_angles, fill_loop_with, quantile,
+    LoopFillOptions, LoopKind, MeshLoop, TriMesh, adjacency, crossings, crossings_with, dihedral_angles,
+    fill_loop_with, quantile,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -177,7 +178,13 @@ pub fn fill_mesh_holes(
         out.positions.extend(&f.positions);
         out.triangles.extend(&f.triangles);
         // no new triangle may cross the input or an earlier fill, nor another of its own
-        if let Some(&(t, u)) = crossings(&out, first, 1).first() {
+        // (the fill checked the first and the last itself when it says so)
+        let crossing = if f.crossing_free {
+            crossings_with(&out, input..first, first, false, 1)
+        } else {
+            crossings(&out, first, 1)
+        };
+        if let Some(&(t, u)) = crossing.first() {
             let other = if u >= first {
                 format!("its own triangle {}", u - first)
             } else if u >= input {

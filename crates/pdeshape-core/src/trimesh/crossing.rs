@@ -33,6 +33,19 @@ const TOL: f64 = 1e-9;
 /// triangle of `m` and `other` any other triangle (a pair of new triangles once), at most
 /// `limit` of them, in increasing order of `new`.
 pub fn crossings(m: &TriMesh, first_new: usize, limit: usize) -> Vec<(usize, usize)> {
+    crossings_with(m, 0..first_new, first_new, true, limit)
+}
+
+/// [`crossings`] of the new triangles with the triangles of `against` only (indices below
+/// `first_new`), and with each other when `own`: a fill already checked against the input
+/// mesh and itself is checked against the fills before it alone.
+pub fn crossings_with(
+    m: &TriMesh,
+    against: std::ops::Range<usize>,
+    first_new: usize,
+    own: bool,
+    limit: usize,
+) -> Vec<(usize, usize)> {
     let nt = m.triangles.len();
     if first_new >= nt || limit == 0 {
         return Vec::new();
@@ -70,7 +83,8 @@ pub fn crossings(m: &TriMesh, first_new: usize, limit: usize) -> Vec<(usize, usi
         Some([0, 1, 2].map(|k| index(l, k)..=index(h, k)))
     };
     let mut grid: HashMap<(usize, usize, usize), Vec<usize>> = HashMap::new();
-    for t in 0..nt {
+    let against = against.start..against.end.min(first_new);
+    for t in against.clone().chain(first_new..nt) {
         if let Some([x, y, z]) = cells_of(t) {
             for i in x.clone() {
                 for j in y.clone() {
@@ -91,7 +105,7 @@ pub fn crossings(m: &TriMesh, first_new: usize, limit: usize) -> Vec<(usize, usi
                 for k in z.clone() {
                     for &u in grid.get(&(i, j, k)).map_or(&[][..], |v| v.as_slice()) {
                         // a pair of new triangles is tested once, from the later one
-                        if u != t && seen[u] != t && (u < first_new || u < t) {
+                        if u != t && seen[u] != t && (u < first_new || (own && u < t)) {
                             seen[u] = t;
                             candidates.push(u);
                         }
@@ -318,5 +332,32 @@ mod tests {
         assert_eq!(crossings(&m, 2, 10), vec![]);
         // the square's own triangles, as new ones, do not cross each other
         assert_eq!(crossings(&m, 0, 10), vec![]);
+    }
+
+    /// Only the triangles asked for are crossed: the new triangle through the square's
+    /// first triangle crosses it when that one is in `against`, not when only the second
+    /// is; two new triangles that cross each other count only with `own`.
+    #[test]
+    fn crossings_with_checks_only_what_it_is_given() {
+        let mut m = TriMesh {
+            positions: vec![
+                v(0.0, 0.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                v(1.0, 1.0, 0.0),
+                v(0.0, 1.0, 0.0),
+                v(0.6, 0.3, -0.2),
+                v(0.7, 0.3, 0.2),
+                v(0.6, 0.4, 0.2),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]],
+        };
+        assert_eq!(crossings_with(&m, 0..2, 2, false, 10), vec![(2, 0)]);
+        assert_eq!(crossings_with(&m, 0..1, 2, false, 10), vec![(2, 0)]);
+        assert_eq!(crossings_with(&m, 1..2, 2, false, 10), vec![]);
+        // the square's two triangles made new and a third through the first
+        m.triangles = vec![[4, 5, 6], [0, 1, 2], [0, 2, 3]];
+        assert_eq!(crossings_with(&m, 0..0, 0, false, 10), vec![]);
+        assert_eq!(crossings_with(&m, 0..0, 0, true, 10), vec![(1, 0)]);
+        assert_eq!(crossings(&m, 0, 10), vec![(1, 0)]);
     }
 }

@@ -97,6 +97,10 @@ pub struct LoopFill {
     /// loop vertex nearest its midpoint (the median length of the mesh's edges at that
     /// vertex and its neighbours).
     pub edge_ratio: (f64, f64),
+    /// Whether the new triangles were checked to cross neither the input mesh nor each
+    /// other (false for the last way of stitching, which is kept unchecked: the caller
+    /// checks it, [`super::crossings`]).
+    pub crossing_free: bool,
 }
 
 /// Why a loop is not filled.
@@ -390,13 +394,15 @@ pub fn fill_loop_with(
     let mut made = None;
     for (k, &(b, flips)) in tries.iter().enumerate() {
         let Some(mesh) = build(b, flips) else { continue };
-        let last = k + 1 == tries.len();
-        if last || crossing_free(original.0, &mesh.0, &mesh.1, base) {
-            made = Some(mesh);
+        if crossing_free(original.0, &mesh.0, &mesh.1, base) {
+            made = Some((mesh, true));
             break;
         }
+        if k + 1 == tries.len() {
+            made = Some((mesh, false));
+        }
     }
-    let (positions, triangles) = made.ok_or(LoopFillError::Unstitched)?;
+    let ((positions, triangles), crossing_free) = made.ok_or(LoopFillError::Unstitched)?;
     // measures: the seam's dihedral angles and the new edges' lengths
     let at = |i: u32| position(m, &positions, base, i);
     let normal = |t: &[u32; 3]| (at(t[1]) - at(t[0])).cross(at(t[2]) - at(t[0]));
@@ -448,6 +454,7 @@ pub fn fill_loop_with(
         seam_dihedral,
         edge_length: h,
         edge_ratio,
+        crossing_free,
     })
 }
 

@@ -20,7 +20,7 @@ mod periodic;
 pub mod shapes;
 
 pub use collar::{Collar, CollarError, CollarFit, adjacency, fit_collar};
-pub use crossing::{crossings, triangles_cross};
+pub use crossing::{crossings, crossings_with, triangles_cross};
 pub use fill::{LoopFill, LoopFillError, LoopFillOptions, fill_loop, fill_loop_with};
 pub use loops::{LoopKind, MeshLoop, TopologyError, boundary, dihedral_angles, quantile};
 pub use periodic::PeriodicSpline;
