@@ -310,10 +310,9 @@ mod tests {
         assert!(!triangles_cross(base, [v(0.1, 0.1, 1e-3), v(0.2, 0.1, 1e-3), v(0.1, 0.2, 1e-3)], 0));
     }
 
-    #[test]
-    fn the_crossing_is_found_in_a_mesh() {
-        // a square of two triangles and a third triangle through it, then lifted off it
-        let mut m = TriMesh {
+    /// A unit square of two triangles and a third triangle through the first of them.
+    fn square_and_through() -> TriMesh {
+        TriMesh {
             positions: vec![
                 v(0.0, 0.0, 0.0),
                 v(1.0, 0.0, 0.0),
@@ -324,7 +323,13 @@ mod tests {
                 v(0.6, 0.4, 0.2),
             ],
             triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]],
-        };
+        }
+    }
+
+    #[test]
+    fn the_crossing_is_found_in_a_mesh() {
+        // a square of two triangles and a third triangle through it, then lifted off it
+        let mut m = square_and_through();
         assert_eq!(crossings(&m, 2, 10), vec![(2, 0)]);
         for i in 4..7 {
             m.positions[i].z += 0.25;
@@ -339,18 +344,7 @@ mod tests {
     /// is; two new triangles that cross each other count only with `own`.
     #[test]
     fn crossings_with_checks_only_what_it_is_given() {
-        let mut m = TriMesh {
-            positions: vec![
-                v(0.0, 0.0, 0.0),
-                v(1.0, 0.0, 0.0),
-                v(1.0, 1.0, 0.0),
-                v(0.0, 1.0, 0.0),
-                v(0.6, 0.3, -0.2),
-                v(0.7, 0.3, 0.2),
-                v(0.6, 0.4, 0.2),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]],
-        };
+        let mut m = square_and_through();
         assert_eq!(crossings_with(&m, 0..2, 2, false, 10), vec![(2, 0)]);
         assert_eq!(crossings_with(&m, 0..1, 2, false, 10), vec![(2, 0)]);
         assert_eq!(crossings_with(&m, 1..2, 2, false, 10), vec![]);
