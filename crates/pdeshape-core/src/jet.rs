@@ -208,6 +208,26 @@ impl Jet {
         }
         let [oa, ob, oc] = self.shape.orders;
         let mut out: Coeffs = smallvec::smallvec![0.0; self.c.len()];
+        if oc == 0 {
+            // two variables: the loops below with the inner pair over contiguous rows (the
+            // same products summed in the same order)
+            let s = ob + 1;
+            for i1 in 0..=oa {
+                for j1 in 0..=ob {
+                    let x = self.c[i1 * s + j1];
+                    if x == 0.0 {
+                        continue;
+                    }
+                    for i2 in 0..=oa - i1 {
+                        let dst = &mut out[(i1 + i2) * s + j1..(i1 + i2 + 1) * s];
+                        for (a, b) in dst.iter_mut().zip(&o.c[i2 * s..i2 * s + s - j1]) {
+                            *a += x * b;
+                        }
+                    }
+                }
+            }
+            return Jet { shape: self.shape, c: out };
+        }
         for i1 in 0..=oa {
             for j1 in 0..=ob {
                 for k1 in 0..=oc {

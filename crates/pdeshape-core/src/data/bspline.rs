@@ -203,49 +203,55 @@ impl Field for BSplineCurve {
 /// `dᵏ N_{span−p+r}/dxᵏ` (The NURBS Book, A2.3, with its final factor `p!/(p−k)!`).
 pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
     let u = knots;
-    let mut ndu = vec![vec![0.0; p + 1]; p + 1];
-    let mut left = vec![0.0; p + 1];
-    let mut right = vec![0.0; p + 1];
-    ndu[0][0] = 1.0;
+    // the tables of A2.3 flat and on the stack up to degree 7 (cubics in the mesh collars,
+    // called for every jet): `ndu[i][j]` at `i·(p+1) + j`, `a[s][j]` at `s·(p+1) + j`
+    let w = p + 1;
+    let mut ndu: smallvec::SmallVec<[f64; 64]> = smallvec::smallvec![0.0; w * w];
+    let mut left: smallvec::SmallVec<[f64; 8]> = smallvec::smallvec![0.0; w];
+    let mut right: smallvec::SmallVec<[f64; 8]> = smallvec::smallvec![0.0; w];
+    ndu[0] = 1.0;
     for j in 1..=p {
         left[j] = x - u[span + 1 - j];
         right[j] = u[span + j] - x;
         let mut saved = 0.0;
         for r in 0..j {
-            ndu[j][r] = right[r + 1] + left[j - r];
-            let temp = ndu[r][j - 1] / ndu[j][r];
-            ndu[r][j] = saved + right[r + 1] * temp;
+            ndu[j * w + r] = right[r + 1] + left[j - r];
+            let temp = ndu[r * w + j - 1] / ndu[j * w + r];
+            ndu[r * w + j] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
         }
-        ndu[j][j] = saved;
+        ndu[j * w + j] = saved;
     }
+    let ndu = |i: usize, j: usize| ndu[i * w + j];
     let nd = nd.min(p);
     let mut ders = vec![vec![0.0; p + 1]; nd + 1];
-    for j in 0..=p {
-        ders[0][j] = ndu[j][p];
+    for (j, d) in ders[0].iter_mut().enumerate() {
+        *d = ndu(j, p);
     }
-    let mut a = vec![vec![0.0; p + 1]; 2];
+    let mut a: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; 2 * w];
+    // `r` indexes A2.3's tables as well as `ders`
+    #[allow(clippy::needless_range_loop)]
     for r in 0..=p {
-        let (mut s1, mut s2) = (0usize, 1usize);
-        a[0][0] = 1.0;
+        let (mut s1, mut s2) = (0usize, w);
+        a[0] = 1.0;
         for k in 1..=nd {
             let mut d = 0.0;
             let rk = r as isize - k as isize;
             let pk = p - k;
             if r >= k {
-                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
-                d = a[s2][0] * ndu[rk as usize][pk];
+                a[s2] = a[s1] / ndu(pk + 1, rk as usize);
+                d = a[s2] * ndu(rk as usize, pk);
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
             let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
             for j in j1..=j2 {
                 let idx = (rk + j as isize) as usize;
-                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
-                d += a[s2][j] * ndu[idx][pk];
+                a[s2 + j] = (a[s1 + j] - a[s1 + j - 1]) / ndu(pk + 1, idx);
+                d += a[s2 + j] * ndu(idx, pk);
             }
             if r <= pk {
-                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
-                d += a[s2][k] * ndu[r][pk];
+                a[s2 + k] = -a[s1 + k - 1] / ndu(pk + 1, r);
+                d += a[s2 + k] * ndu(r, pk);
             }
             ders[k][r] = d;
             std::mem::swap(&mut s1, &mut s2);

@@ -85,11 +85,15 @@ impl Field for Collar {
         let [p] = spline_derivatives(&self.spine.0, [&self.spine.1], w, ow);
         let dk = spline_derivatives(&self.d.0, self.d.1.each_ref().map(|c| c.as_slice()), w, ow);
         let binom = |k: usize, i: usize| -> f64 { (1..=i).map(|r| (k + 1 - r) as f64 / r as f64).product() };
+        // `∂ˢⁱ sᵏ = C(k, i) sᵏ⁻ⁱ`, once for the three components
+        let f: [[f64; 4]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|k| if k >= i { binom(k, i) * s.powi((k - i) as i32) } else { 0.0 })
+        });
         VecJet(std::array::from_fn(|q| {
             let mut c = vec![0.0; shape.len()];
             for i in 0..=os.min(3) {
                 for j in 0..=ow {
-                    let mut v: f64 = (i..=3).map(|k| binom(k, i) * s.powi((k - i) as i32) * dk[k][j][q]).sum();
+                    let mut v: f64 = (i..=3).map(|k| f[i][k] * dk[k][j][q]).sum();
                     if i == 0 {
                         v += p[j][q];
                     }
