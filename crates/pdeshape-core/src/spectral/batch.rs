@@ -236,8 +236,13 @@ impl SpectralPatch {
                     }
                     continue;
                 }
-                // the Fourier tails of the data, r_c^{(j)} = g_c^{(j)} − F_M[g_c]^{(j)}
+                // the Fourier tails of the data, r_c^{(j)} = g_c^{(j)} − F_M[g_c]^{(j)}; zero for
+                // a datum proved a trigonometric polynomial, as in the pointwise path
                 for (c, s) in self.series.iter().enumerate() {
+                    if self.exact[c] {
+                        tails[c * nj..(c + 1) * nj].fill(Vec3::ZERO);
+                        continue;
+                    }
                     for j in 0..nj {
                         let mut sum = if j == 0 { s.a[0] } else { Vec3::ZERO };
                         for (n, ((a, b), &t)) in s.a.iter().zip(&s.b).zip(&cs).enumerate().skip(1) {
