@@ -97,9 +97,17 @@ fn print_check(sc: &Scene, d: &SceneReport) -> Result<()> {
         );
         if let Some(sp) = &p.spectral {
             outln!(
-                "      order {}, M = {}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}, truncated-part residual {:.1e} (relative)",
+                "      order {}, M = {}{}, ω = {}, max mode condition {:.2e} ({} modes f64, {} multiprecision), Lebesgue {:.3}, truncated-part residual {:.1e} (relative)",
                 sp.order,
                 sp.modes,
+                if sp.modes_kept < sp.modes {
+                    format!(
+                        " (data of degree ≤ {}: modes above it and the remainder are zero, not solved)",
+                        sp.modes_kept
+                    )
+                } else {
+                    String::new()
+                },
                 json_text(&sp.omega),
                 sp.max_mode_condition_number,
                 sp.modes_solved_in_f64,

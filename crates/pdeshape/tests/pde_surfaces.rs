@@ -86,32 +86,45 @@ fn red_blood_cell_follows_the_biconcave_profile() {
 /// Order 40 in plain f64 at both ends of the Klein bottle's slider (`a` = 0.3 and 3.0):
 /// every mode and the remainder take an f64 path (the exponential basis or the
 /// ultraspherical Chebyshev system, none multiple precision), and the 40 sections hold to
-/// 1e-10 relative at the check's 1000 samples.
+/// 1e-10 relative at the check's 1000 samples. The example's sections are trigonometric
+/// polynomials of degree 1 in `v`, so only modes 0 and 1 are solved; with a term of degree
+/// above M = 6 in their `z` every mode and the remainder are.
 #[test]
 fn klein_bottle_is_exact_in_f64_across_the_slider() {
-    let text = example_text("klein-bottle.toml");
-    for a in [0.3, 3.0] {
-        let scene = Scene::parse(&text, "k.toml", "k", &HashMap::from([("a".to_string(), a)])).unwrap();
-        let r = model::condition_report(&scene.patches[0]);
-        assert!(r.max_rel <= 1e-10, "a = {a}: sections met to {:e}", r.max_rel);
-        let rep = scene.patches[0].spectral.as_ref().unwrap().report();
-        assert_eq!(rep.methods.1, 0, "a = {a}: {:?}", rep.mode_paths);
-        assert_eq!(rep.mode_paths.len(), 8, "modes 0…6 and the remainder");
-        assert!(rep.mode_paths.iter().all(|p| p.starts_with("f64")), "a = {a}: {:?}", rep.mode_paths);
-        assert!(rep.mode_paths.contains(&"f64-ultraspherical"), "a = {a}: {:?}", rep.mode_paths);
-        // the truncated part's PDE residual at order 40, per mode, from the Chebyshev
-        // coefficients (relative to the operator's terms): measured 4e-14 … 2.3e-10 over
-        // a = 0.3 … 3, the largest for mode 1 at a = 0.3, nearly a polynomial of degree
-        // < 40, whose coefficients' round-off D^40 amplifies
-        assert_eq!(rep.mode_residuals.len(), 8);
-        for (m, r) in rep.mode_residuals.iter().enumerate() {
-            assert!(*r <= 1e-9, "a = {a}, mode {m}: residual {r:e} ({})", rep.mode_paths[m]);
+    let example = example_text("klein-bottle.toml");
+    let every_mode = example.replace("\"4*(1 - cos(s)/2)*sin(v)\"", "\"4*(1 - cos(s)/2)*sin(v) + 0.01*exp(cos(v))\"");
+    assert_ne!(example, every_mode);
+    for (text, kept) in [(&example, 1), (&every_mode, 6)] {
+        for a in [0.3, 3.0] {
+            let scene = Scene::parse(text, "k.toml", "k", &HashMap::from([("a".to_string(), a)])).unwrap();
+            let r = model::condition_report(&scene.patches[0]);
+            assert!(r.max_rel <= 1e-10, "a = {a}: sections met to {:e}", r.max_rel);
+            let rep = scene.patches[0].spectral.as_ref().unwrap().report();
+            assert_eq!(rep.kept, kept, "a = {a}: {:?}", rep.mode_paths);
+            assert_eq!(rep.methods, (kept + 1, 0), "a = {a}: {:?}", rep.mode_paths);
+            assert_eq!(rep.mode_paths.len(), 8, "modes 0…6 and the remainder");
+            let (solved, zero) = rep.mode_paths.split_at(kept + 1);
+            assert!(solved.iter().all(|p| p.starts_with("f64")), "a = {a}: {:?}", rep.mode_paths);
+            assert!(solved.contains(&"f64-ultraspherical"), "a = {a}: {:?}", rep.mode_paths);
+            // the modes above the data's degree and the remainder are zero, not solved; with
+            // a datum of higher degree only the remainder is left after mode 6
+            let want_zero =
+                |p: &&str| if kept == 6 { p.starts_with("f64") } else { *p == pdeshape_core::spectral::NO_DATA };
+            assert!(zero.iter().all(want_zero), "a = {a}: {:?}", rep.mode_paths);
+            // the truncated part's PDE residual at order 40, per mode, from the Chebyshev
+            // coefficients (relative to the operator's terms): measured 4e-14 … 2.3e-10 over
+            // a = 0.3 … 3, the largest for mode 1 at a = 0.3, nearly a polynomial of degree
+            // < 40, whose coefficients' round-off D^40 amplifies
+            assert_eq!(rep.mode_residuals.len(), 8);
+            for (m, r) in rep.mode_residuals.iter().enumerate() {
+                assert!(*r <= 1e-9, "a = {a}, mode {m}: residual {r:e} ({})", rep.mode_paths[m]);
+            }
+            // derivative orders beyond the tabulated ones are derived, not a panic
+            let deep = scene.patches[0].surface.derivatives(0.37, 1.1, 4, 1);
+            assert!(deep.len() == 10 && deep.iter().all(|x| x.is_finite()), "a = {a}");
+            let d = model::patch_diagnostics(&scene.patches[0]).to_json();
+            let t = d["spectral"]["truncated_residual_relative"].as_f64().unwrap();
+            assert!(t <= 1e-9, "a = {a}: {t:e}");
         }
-        // derivative orders beyond the tabulated ones are derived, not a panic
-        let deep = scene.patches[0].surface.derivatives(0.37, 1.1, 4, 1);
-        assert!(deep.len() == 10 && deep.iter().all(|x| x.is_finite()), "a = {a}");
-        let d = model::patch_diagnostics(&scene.patches[0]).to_json();
-        let t = d["spectral"]["truncated_residual_relative"].as_f64().unwrap();
-        assert!(t <= 1e-9, "a = {a}: {t:e}");
     }
 }

@@ -38,7 +38,8 @@ pub(super) const KMAX: usize = 1;
 /// Every mode's `(A_n, B_n)` and the remainder's cardinal functions, folded.
 pub(super) struct Folded {
     modes: Vec<Combined>,
-    rem: Combined,
+    /// None when the patch has no remainder (every datum a proved trigonometric polynomial).
+    rem: Option<Combined>,
     /// All the conditions' data in one tape, when they are expression fields in the same
     /// variables (at most `v, t`): what the sections share (`cos v`, `sin v`) is computed
     /// once per point, not once per section.
@@ -99,7 +100,8 @@ impl Folded {
             })
             .collect();
         let eye: Vec<f64> = (0..nc * nc).map(|k| f64::from(k / nc == k % nc)).collect();
-        Folded { modes, rem: Combined::new(&p.rem, eye, nc, KMAX), joint: joint_tape(&p.data) }
+        let rem = p.rem.as_ref().map(|r| Combined::new(r, eye, nc, KMAX));
+        Folded { modes, rem, joint: joint_tape(&p.data) }
     }
 }
 
@@ -142,12 +144,12 @@ impl SpectralPatch {
         let jmax = orders.iter().map(|o| o.1).max().unwrap_or(0);
         assert!(imax <= KMAX, "u-derivatives up to {KMAX} at scattered points");
         let f = self.folded();
-        let (m, nc, nj) = (self.opts.modes, self.conds.len(), jmax + 1);
+        let (m, nc, nj) = (self.kept, self.conds.len(), jmax + 1);
         let a = self.opts.a;
-        let scratch_len = f.modes.iter().map(Combined::scratch_len).chain([f.rem.scratch_len()]).max().unwrap_or(0);
+        let scratch_len = f.modes.iter().chain(&f.rem).map(Combined::scratch_len).max().unwrap_or(0);
         let mut scratch = vec![0.0; scratch_len];
         // T_m(2u − 1) once per point for every Chebyshev combination
-        let rem_terms = if self.exact_series { 0 } else { f.rem.chebyshev_terms() };
+        let rem_terms = f.rem.as_ref().map_or(0, Combined::chebyshev_terms);
         let terms = f.modes.iter().map(Combined::chebyshev_terms).chain([rem_terms]).max().unwrap_or(0);
         let mut cheb = vec![0.0; if terms > 0 { terms.max(2) } else { 0 }];
         let mut fold = vec![0.0; (imax + 1) * 6];
@@ -230,12 +232,12 @@ impl SpectralPatch {
                         acc[d] += (av * c + bv * s) * npow(n, j);
                     }
                 }
-                if self.exact_series {
+                let Some(rem) = &f.rem else {
                     for (d, &(_, j)) in orders.iter().enumerate() {
                         o[d] = acc[d] * if j < 4 { scale[j] } else { self.dtheta_dv.powi(j as i32) };
                     }
                     continue;
-                }
+                };
                 // the Fourier tails of the data, r_c^{(j)} = g_c^{(j)} − F_M[g_c]^{(j)}; zero for
                 // a datum proved a trigonometric polynomial, as in the pointwise path
                 for (c, s) in self.series.iter().enumerate() {
@@ -252,7 +254,7 @@ impl SpectralPatch {
                         tails[c * nj + j] = g[(c * BLOCK + k) * nj + j] - sum;
                     }
                 }
-                f.rem.eval(u, imax, None, &cheb, &mut scratch, &mut lrem);
+                rem.eval(u, imax, None, &cheb, &mut scratch, &mut lrem);
                 for (d, &(i, j)) in orders.iter().enumerate() {
                     let l = &lrem[i * nc..(i + 1) * nc];
                     let mut r = Vec3::ZERO;

@@ -90,8 +90,16 @@ pub struct SpectralPatch {
     conds: Vec<CondSpec>,
     data: Vec<FieldRef>,
     series: Vec<FourierSeries>,
+    /// The cardinal sets of modes `0 … kept`: the modes above `kept` have no data.
     cards: Vec<Arc<CardinalSet>>,
-    rem: Arc<CardinalSet>,
+    /// The remainder's cardinal set; none when every datum is proved a trigonometric
+    /// polynomial of degree ≤ M (`exact_series`: the tails and so the remainder are zero).
+    rem: Option<Arc<CardinalSet>>,
+    /// The modes summed: `M`, or the largest proved degree when every datum is proved a
+    /// trigonometric polynomial of degree ≤ M. Mode `n` of the solution is
+    /// `Σ_i ℓ_i^{(n)}(u) (a_{i,n} cos nθ + b_{i,n} sin nθ)`, identically zero when every
+    /// datum's coefficients of order `n` are: such modes are neither solved nor summed.
+    kept: usize,
     /// Order of the derivatives tabulated on demand (`2N` for `N ≤ 10`, else none beyond
     /// what the solve tabulated) and the cardinal functions tabulated to it: computed the
     /// first time a derivative above the solve's order is asked for (the PDE residual,
@@ -115,15 +123,18 @@ pub struct SpectralPatch {
     exact: Vec<bool>,
 }
 
-/// Whether the datum `g(θ, t)` is proved a trigonometric polynomial of degree at most
-/// `modes` in θ that does not depend on `t` ([`Field::trig_degree`]; the series is analysed
-/// at one time).
-fn finite_series(g: &FieldRef, modes: usize) -> bool {
-    g.trig_degree().is_some_and(|d| d <= modes)
+/// The degree `d ≤ modes` of the datum `g(θ, t)` when it is proved a trigonometric
+/// polynomial of degree at most `d` in θ that does not depend on `t`
+/// ([`Field::trig_degree`]; the series is analysed at one time).
+fn finite_series(g: &FieldRef, modes: usize) -> Option<usize> {
+    g.trig_degree().filter(|&d| d <= modes)
 }
 
 /// The modes' cardinal sets and the remainder's.
-type CardSets = (Vec<Arc<CardinalSet>>, Arc<CardinalSet>);
+type CardSets = (Vec<Arc<CardinalSet>>, Option<Arc<CardinalSet>>);
+
+/// What a mode without data reports as its path: it is neither solved nor summed.
+pub const NO_DATA: &str = "none: no data of this degree";
 
 impl std::fmt::Debug for SpectralPatch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -144,12 +155,18 @@ pub struct SpectralReport {
     /// (multiple precision).
     pub max_mode_condition: f64,
     /// How the cardinal functions were computed: counts of `f64` (exponential basis or
-    /// ultraspherical) and `multiprecision` modes.
+    /// ultraspherical) and `multiprecision` modes, over the modes solved.
     pub methods: (usize, usize),
+    /// The modes solved and summed, `0 … kept`: `M`, or the largest degree of the data when
+    /// every datum is proved a trigonometric polynomial (the modes above it, and then the
+    /// remainder, are identically zero).
+    pub kept: usize,
     /// The path of every mode `0 … M` and then of the remainder (`"f64"`,
-    /// `"f64-ultraspherical"`, `"multiprecision"`).
+    /// `"f64-ultraspherical"`, `"multiprecision"`, or [`NO_DATA`] for a mode or remainder
+    /// that is identically zero and was not solved).
     pub mode_paths: Vec<&'static str>,
-    /// The ODE residual of every mode's cardinal functions (`0 … M`, then the remainder's),
+    /// The ODE residual of every mode's cardinal functions (`0 … M`, then the remainder's;
+    /// 0 where nothing was solved),
     /// relative to the operator's terms, computed in Chebyshev coefficients through the
     /// banded operators for every order ([`crate::ode::CardinalSet::residual`]; 0 for
     /// the exact exponential basis). The truncated part `X̃ = Σ_m U_m(u) e^{imθ}` has PDE
@@ -244,10 +261,26 @@ impl SpectralPatch {
             )
         };
         let samples = sample_count(opts.modes);
-        let series: Vec<FourierSeries> =
-            data.par_iter().map(|g| FourierSeries::analyse(|th| g.eval(&[th, 0.0]), opts.modes, samples)).collect();
+        let degrees: Vec<Option<usize>> =
+            data.iter().map(|d| finite_series(d, opts.modes).filter(|_| domain.periodic)).collect();
+        let exact_series = degrees.iter().all(Option::is_some);
+        let kept = if exact_series { degrees.iter().flatten().copied().max().unwrap_or(0) } else { opts.modes };
+        let series: Vec<FourierSeries> = data
+            .par_iter()
+            .zip(&degrees)
+            .map(|(g, d)| {
+                let mut s = FourierSeries::analyse(|th| g.eval(&[th, 0.0]), opts.modes, samples);
+                // a proved degree d: the coefficients above d are zero, not their round-off
+                if let Some(d) = *d {
+                    for n in d + 1..s.a.len() {
+                        (s.a[n], s.b[n]) = (Vec3::ZERO, Vec3::ZERO);
+                    }
+                }
+                s
+            })
+            .collect();
         let what = describe(&specs);
-        let cards: Vec<Arc<CardinalSet>> = (0..=opts.modes)
+        let cards: Vec<Arc<CardinalSet>> = (0..=kept)
             .into_par_iter()
             .map(|m| {
                 crate::cancel::checkpoint();
@@ -258,11 +291,15 @@ impl SpectralPatch {
                 })
             })
             .collect::<Result<_, _>>()?;
-        let rem = cardinal_set(omega, n, &specs, kmax).map_err(|source| SpectralError::Conditions {
-            mode: format!("ω = {omega}"),
-            what,
-            source,
-        })?;
+        let rem = if exact_series {
+            None
+        } else {
+            Some(cardinal_set(omega, n, &specs, kmax).map_err(|source| SpectralError::Conditions {
+                mode: format!("ω = {omega}"),
+                what,
+                source,
+            })?)
+        };
         Ok(SpectralPatch {
             domain,
             dtheta_dv,
@@ -273,13 +310,14 @@ impl SpectralPatch {
             series,
             cards,
             rem,
+            kept,
             deep_kmax: if n <= 10 { 2 * n } else { 0 },
             deep: OnceLock::new(),
             time: 0.0,
             cache: BoundedMemo::new(4096),
             folded: OnceLock::new(),
-            exact: data.iter().map(|d| domain.periodic && finite_series(d, opts.modes)).collect(),
-            exact_series: domain.periodic && data.iter().all(|d| finite_series(d, opts.modes)),
+            exact: degrees.iter().map(Option::is_some).collect(),
+            exact_series,
             data,
         })
     }
@@ -309,10 +347,17 @@ impl SpectralPatch {
             omega: self.omega,
             max_mode_condition,
             methods: (self.cards.len() - mp, mp),
-            mode_paths: self.cards.iter().chain(std::iter::once(&self.rem)).map(|c| c.method()).collect(),
-            mode_residuals: self.cards.iter().chain(std::iter::once(&self.rem)).map(|c| c.residual()).collect(),
+            kept: self.kept,
+            mode_paths: self.sets_or_none().map(|c| c.map_or(NO_DATA, |c| c.method())).collect(),
+            mode_residuals: self.sets_or_none().map(|c| c.map_or(0.0, |c| c.residual())).collect(),
             lebesgue: (self.cards[0].lebesgue(400), self.cards.get(1).map(|c| c.lebesgue(400))),
         }
+    }
+
+    /// The cardinal set of every mode `0 … M` and of the remainder, none where there are
+    /// no data.
+    fn sets_or_none(&self) -> impl Iterator<Item = Option<&Arc<CardinalSet>>> {
+        (0..=self.opts.modes).map(|m| self.cards.get(m)).chain([self.rem.as_ref()])
     }
 
     /// Drops the per-row cache (rows are recomputed on the next evaluation).
@@ -326,23 +371,31 @@ impl SpectralPatch {
 
     /// Cardinal sets that hold derivatives up to `k` if any do: the solve's, or the ones
     /// tabulated to `deep_kmax` on demand.
-    fn sets(&self, k: usize) -> (&[Arc<CardinalSet>], &Arc<CardinalSet>) {
-        let fast = self.cards.iter().all(|c| c.kmax() >= k) && self.rem.kmax() >= k;
+    fn sets(&self, k: usize) -> (&[Arc<CardinalSet>], Option<&Arc<CardinalSet>>) {
+        let fast = self.cards.iter().chain(&self.rem).all(|c| c.kmax() >= k);
         if fast || k > self.deep_kmax {
-            return (&self.cards, &self.rem);
+            return (&self.cards, self.rem.as_ref());
         }
         let deep = self.deep.get_or_init(|| {
             let (n, a, kk) = (self.n, self.opts.a, self.deep_kmax);
-            let cards: Option<Vec<_>> = (0..=self.opts.modes)
-                .into_par_iter()
-                .map(|m| cardinal_set(a * m as f64, n, &self.conds, kk).ok())
-                .collect();
-            Some((cards?, cardinal_set(self.omega, n, &self.conds, kk).ok()?))
+            let cards: Option<Vec<_>> =
+                (0..=self.kept).into_par_iter().map(|m| cardinal_set(a * m as f64, n, &self.conds, kk).ok()).collect();
+            let rem = match self.rem {
+                Some(_) => Some(cardinal_set(self.omega, n, &self.conds, kk).ok()?),
+                None => None,
+            };
+            Some((cards?, rem))
         });
         match deep {
-            Some((c, r)) => (c, r),
-            None => (&self.cards, &self.rem),
+            Some((c, r)) => (c, r.as_ref()),
+            None => (&self.cards, self.rem.as_ref()),
         }
+    }
+
+    /// The remainder's cardinal functions at `u` (derivatives to `k`), zeros without a
+    /// remainder.
+    fn rem_row(&self, rem: Option<&Arc<CardinalSet>>, u: f64, k: usize) -> Vec<Vec<f64>> {
+        rem.map_or_else(|| vec![vec![0.0; self.conds.len()]; k + 1], |r| r.eval(u, k))
     }
 
     fn row(&self, u: f64, k: usize) -> Arc<Row> {
@@ -352,18 +405,19 @@ impl SpectralPatch {
         }
         let (cards, rem) = self.sets(k);
         let modes: Vec<Vec<Vec<f64>>> = cards.iter().map(|card| card.eval(u, k)).collect();
-        let row = Arc::new(self.row_from(&modes, rem.eval(u, k), k));
+        let row = Arc::new(self.row_from(&modes, self.rem_row(rem, u, k), k));
         self.cache.insert(key, row.clone());
         row
     }
 
     /// The row at `u` from each mode's cardinal functions `modes[mode][kk][i] = ℓ_i^{(kk)}(u)`
-    /// and the remainder's `l`: the modes folded with the data's Fourier coefficients.
+    /// (modes `0 … kept` are read) and the remainder's `l`: the modes folded with the data's
+    /// Fourier coefficients.
     fn row_from(&self, modes: &[Vec<Vec<f64>>], l: Vec<Vec<f64>>, k: usize) -> Row {
-        let m = self.opts.modes;
+        let m = self.kept;
         let mut a = vec![vec![Vec3::ZERO; m + 1]; k + 1];
         let mut b = vec![vec![Vec3::ZERO; m + 1]; k + 1];
-        for (mode, lm) in modes.iter().enumerate() {
+        for (mode, lm) in modes.iter().take(m + 1).enumerate() {
             for (kk, lk) in lm.iter().enumerate() {
                 for (i, s) in self.series.iter().enumerate() {
                     a[kk][mode] += s.a[mode] * lk[i];
@@ -377,15 +431,21 @@ impl SpectralPatch {
     /// Fills the row caches of `patches` at every `u` of `us` (derivatives to `k`) from one
     /// evaluation of the cardinal functions a `u`. Patches solved for the same conditions'
     /// places and orders, `a`, `M` and `ω` share their cardinal sets (process-wide) and differ
-    /// in their data alone — the members of a fill family; a patch whose sets are not the
-    /// first's is left to compute its own rows. The rows are those [`row`](Self::row)
-    /// computes, bit for bit (the same sums in the same order).
+    /// in their data alone — the members of a fill family (those whose data are all proved
+    /// trigonometric polynomials have fewer modes and no remainder: the first of the
+    /// others'). A patch whose sets are not the reference's (the one with the most) is left
+    /// to compute its own rows. The rows are those [`row`](Self::row) computes, bit for bit
+    /// (the same sums in the same order).
     pub fn share_rows(patches: &[&SpectralPatch], us: &[f64], k: usize) {
-        let Some(first) = patches.first() else { return };
-        let (cards, rem) = first.sets(k);
+        let Some(reference) = patches.iter().copied().max_by_key(|p| (p.rem.is_some(), p.kept)) else { return };
+        let (cards, rem) = reference.sets(k);
         let same = |p: &SpectralPatch| {
             let (c, r) = p.sets(k);
-            Arc::ptr_eq(r, rem) && c.len() == cards.len() && c.iter().zip(cards).all(|(x, y)| Arc::ptr_eq(x, y))
+            let rem_shared = match (r, rem) {
+                (Some(r), Some(rem)) => Arc::ptr_eq(r, rem),
+                (r, _) => r.is_none(),
+            };
+            rem_shared && c.len() <= cards.len() && c.iter().zip(cards).all(|(x, y)| Arc::ptr_eq(x, y))
         };
         let sharing: Vec<&SpectralPatch> = patches.iter().copied().filter(|p| same(p)).collect();
         for &u in us {
@@ -394,19 +454,21 @@ impl SpectralPatch {
                 continue;
             }
             let modes: Vec<Vec<Vec<f64>>> = cards.iter().map(|card| card.eval(u, k)).collect();
-            let l = rem.eval(u, k);
+            let l = reference.rem_row(rem, u, k);
             for p in &sharing {
-                p.cache.insert(key, Arc::new(p.row_from(&modes, l.clone(), k)));
+                let l = if p.rem.is_some() { l.clone() } else { p.rem_row(None, u, k) };
+                p.cache.insert(key, Arc::new(p.row_from(&modes, l, k)));
             }
         }
     }
 
-    /// `(cos nθ, sin nθ)` for `n = 0 … M`.
+    /// `(cos nθ, sin nθ)` for `n = 0 … kept` (`M` whenever a datum's tails are summed).
     fn trig(&self, theta: f64) -> Vec<(f64, f64)> {
-        (0..=self.opts.modes).map(|n| (n as f64 * theta).sin_cos()).map(|(s, c)| (c, s)).collect()
+        (0..=self.kept).map(|n| (n as f64 * theta).sin_cos()).map(|(s, c)| (c, s)).collect()
     }
 
-    /// `r_i^{(j)}(θ)` for every condition, `j = 0 … jmax` (θ-derivatives).
+    /// `r_i^{(j)}(θ)` for every condition, `j = 0 … jmax` (θ-derivatives); none at all when
+    /// every datum's tails are zero (`exact_series`).
     fn tails(&self, theta: f64, jmax: usize) -> Vec<Vec<Vec3>> {
         self.tails_with(theta, &self.trig(theta), jmax)
     }
@@ -414,7 +476,7 @@ impl SpectralPatch {
     /// [`tails`](Self::tails) with `cs = trig(θ)` given.
     fn tails_with(&self, theta: f64, cs: &[(f64, f64)], jmax: usize) -> Vec<Vec<Vec3>> {
         if self.exact_series {
-            return vec![vec![Vec3::ZERO; jmax + 1]; self.data.len()];
+            return Vec::new();
         }
         self.data
             .iter()
@@ -435,7 +497,7 @@ impl SpectralPatch {
     /// `∂^{i+j}X/∂uⁱ∂θʲ` at one point, from a cached row and the tails at θ.
     fn combine(&self, row: &Row, tails: &[Vec<Vec3>], theta: f64, i: usize, j: usize) -> Vec3 {
         let mut s = Vec3::ZERO;
-        for n in 0..=self.opts.modes {
+        for n in 0..=self.kept {
             let nf = n as f64;
             if n == 0 {
                 if j == 0 {
@@ -458,8 +520,9 @@ impl SpectralPatch {
     /// not an exact Fourier solution of the PDE. It tends to zero with `M` for continuous
     /// data (uniformly, as the Fourier tails `r_i` do).
     pub fn remainder(&self, u: f64, v: f64) -> Vec3 {
+        let Some(rem) = &self.rem else { return Vec3::ZERO };
         let theta = self.theta(v);
-        let l = self.rem.eval(u, 0);
+        let l = rem.eval(u, 0);
         self.tails(theta, 0).iter().zip(&l[0]).map(|(t, w)| t[0] * *w).sum()
     }
 
@@ -484,17 +547,20 @@ impl SpectralPatch {
             }
             r
         });
-        let rem = (rem_set.kmax() >= k).then(|| {
-            let l = rem_set.eval(u, k);
-            let tails = self.tails(theta, k);
-            let mut rem = Vec3::ZERO;
-            for q in 0..=n {
-                let w = binom(n, q) * a2.powi((n - q) as i32);
-                for (c, t) in tails.iter().enumerate() {
-                    rem += t[2 * (n - q)] * (l[2 * q][c] * w);
+        // no remainder (every datum a proved trigonometric polynomial): R ≡ 0
+        let rem = rem_set.map_or(Some(Vec3::ZERO), |rem_set| {
+            (rem_set.kmax() >= k).then(|| {
+                let l = rem_set.eval(u, k);
+                let tails = self.tails(theta, k);
+                let mut rem = Vec3::ZERO;
+                for q in 0..=n {
+                    let w = binom(n, q) * a2.powi((n - q) as i32);
+                    for (c, t) in tails.iter().enumerate() {
+                        rem += t[2 * (n - q)] * (l[2 * q][c] * w);
+                    }
                 }
-            }
-            rem
+                rem
+            })
         });
         Residual {
             truncated: trunc.map(|t| t.norm()),
@@ -572,8 +638,8 @@ impl SpectralPatch {
     /// `∂uⁱ∂θʲ X_x = Rᵢ · Qⱼ`, `Rᵢ = [a⁽ⁱ⁾₀ₓ(u) | a⁽ⁱ⁾ₙₓ(u) | b⁽ⁱ⁾ₙₓ(u) | ℓ⁽ⁱ⁾_c(u)]` (a row per `u`),
     /// `Qⱼ = [δⱼ₀ ; ∂θʲ cos nθ ; ∂θʲ sin nθ ; r⁽ʲ⁾_{c,x}(θ)]` (a column per `v`),
     ///
-    /// with `n = 1 … M` and `c` the conditions (the remainder's cardinal functions times the
-    /// Fourier tails). The mode functions are computed once per `u`, the data once per `v`;
+    /// with `n = 1 … kept` and `c` the conditions whose data are not proved trigonometric
+    /// polynomials (the remainder's cardinal functions times the Fourier tails). The mode functions are computed once per `u`, the data once per `v`;
     /// the products run in faer's GEMM, one per order and component, in parallel.
     fn grid_products<const D: usize>(&self, us: &[f64], vs: &[f64], orders: [(usize, usize); D]) -> Vec<[Vec3; D]> {
         // One entry into the thread pool for the whole grid: called from outside the pool,
@@ -603,8 +669,11 @@ impl SpectralPatch {
                 self.row(u, imax)
             })
             .collect();
-        let (m, nc) = (self.opts.modes, self.conds.len());
-        let width = 1 + 2 * m + nc;
+        // the modes with data, and a tail column for each datum not proved a trigonometric
+        // polynomial (the others' tails are zero)
+        let m = self.kept;
+        let tailc: Vec<usize> = (0..self.conds.len()).filter(|&c| !self.exact[c]).collect();
+        let width = 1 + 2 * m + tailc.len();
         let r_mat = |i: usize, x: usize| {
             Mat::<f64>::from_fn(nu, width, |ui, f| {
                 let row = &rows[ui];
@@ -612,7 +681,7 @@ impl SpectralPatch {
                     0 => row.a[i][0][x],
                     f if f <= m => row.a[i][f][x],
                     f if f <= 2 * m => row.b[i][f - m][x],
-                    f => row.l[i][f - 1 - 2 * m],
+                    f => row.l[i][tailc[f - 1 - 2 * m]],
                 }
             })
         };
@@ -635,7 +704,7 @@ impl SpectralPatch {
                     0 => f64::from(j == 0),
                     f if f <= m => trig(f, false),
                     f if f <= 2 * m => trig(f - m, true),
-                    f => col.tails[f - 1 - 2 * m][j][x],
+                    f => col.tails[tailc[f - 1 - 2 * m]][j][x],
                 }
             })
         };

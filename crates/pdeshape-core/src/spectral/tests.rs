@@ -264,7 +264,7 @@ fn data_proved_finite_series_have_no_remainder() {
     let conds: Vec<Condition> = ends.iter().map(|&(u, d)| Condition { u, order: d, data: expr_data(u, d) }).collect();
     let p = SpectralPatch::new(&conds, VDomain::PERIODIC, opts).unwrap();
     assert!(p.exact_series);
-    assert!(p.tails(0.7, 2).iter().flatten().all(|t| *t == Vec3::ZERO));
+    assert!(p.tails(0.7, 2).is_empty(), "no tails to sum");
     let opaque: Vec<Condition> =
         ends.iter().map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) }).collect();
     let q = SpectralPatch::new(&opaque, VDomain::PERIODIC, opts).unwrap();
@@ -334,4 +334,36 @@ fn data_proved_finite_series_have_no_remainder() {
     }
     // as above: a few ulps of values and derivatives ≤ 10
     assert!(apart < 1e-13, "mixed and opaque data differ by {apart:e}");
+
+    // the data are of degree ≤ 3 < M = 4: mode 4 and the remainder are zero and not solved;
+    // every way of evaluating (rows, grids of second derivatives, batches, the residual)
+    // equals the opaque data's, which solve and sum them
+    let rep = p.report();
+    assert_eq!((rep.kept, rep.methods), (3, (4, 0)));
+    assert_eq!(rep.mode_paths[4..], [NO_DATA, NO_DATA]);
+    assert_eq!(rep.mode_residuals[4..], [0.0, 0.0]);
+    assert_eq!((p.cards.len(), p.rem.is_none()), (4, true));
+    let qr = q.report();
+    assert_eq!((qr.kept, q.cards.len(), q.rem.is_some()), (4, 5, true));
+    assert_eq!(p.remainder(0.3, 1.7), Vec3::ZERO);
+    assert_eq!(p.residual(0.3, 1.7).remainder, Some(0.0));
+    let us: Vec<f64> = (0..=12).map(|i| i as f64 / 12.0).collect();
+    let vs: Vec<f64> = (0..17).map(|j| j as f64 * 0.37).collect();
+    let uv: Vec<[f64; 2]> = us.iter().flat_map(|&u| vs.iter().map(move |&v| [u, v])).collect();
+    let mut worst: f64 = 0.0;
+    for other in [&q, &r] {
+        for (x, y) in p.grid2(&us, &vs).iter().zip(other.grid2(&us, &vs)) {
+            for (x, y) in x.iter().zip(y) {
+                worst = crate::num::max_nan(worst, (*x - y).norm());
+            }
+        }
+        let (mut fp, mut fq) = (vec![[Vec3::ZERO; 3]; uv.len()], vec![[Vec3::ZERO; 3]; uv.len()]);
+        p.firsts_at(&uv, &mut fp);
+        other.firsts_at(&uv, &mut fq);
+        for (x, y) in fp.iter().flatten().zip(fq.iter().flatten()) {
+            worst = crate::num::max_nan(worst, (*x - *y).norm());
+        }
+    }
+    // second derivatives ≤ ~40 here: a few ulps of them
+    assert!(worst < 1e-12, "grids and batches differ by {worst:e}");
 }

@@ -395,6 +395,7 @@ fn spectral_report(
     SpectralReport {
         order: r.order,
         modes: r.modes,
+        modes_kept: r.kept,
         omega: r.omega,
         max_mode_condition_number: r.max_mode_condition,
         modes_solved_in_f64: r.methods.0,

@@ -431,6 +431,10 @@ pub struct SpectralReport {
     pub order: usize,
     /// Fourier modes `M`.
     pub modes: usize,
+    /// The modes solved and summed (`0 … modes_kept`): `M`, or the largest degree of the
+    /// data when every datum is proved a trigonometric polynomial (the modes above, and the
+    /// remainder, are then identically zero: their paths read "none: no data of this degree").
+    pub modes_kept: usize,
     /// The remainder's `ω`.
     pub omega: f64,
     /// The worst mode's condition number.
