@@ -456,14 +456,9 @@ fn quality(map: &LaplaceMap, p: &[Uv], rings: usize, cols: usize) -> TrimReport 
 /// `(u, v)`).
 pub fn trimmed_mesh(s: &dyn Surface, g: &TrimGrid) -> Result<Mesh, String> {
     let dom = s.v_domain();
-    let evals: Vec<[Vec3; 3]> = g
-        .points
-        .par_iter()
-        .map(|q| {
-            let d = s.derivatives(q[0], q[1], 1, 1);
-            [d[0], d[2], d[1]]
-        })
-        .collect();
+    // the grid's points are scattered in `(u, v)` (no two rings share a `u`): in batches
+    let mut evals = vec![[Vec3::ZERO; 3]; g.points.len()];
+    g.points.par_chunks(512).zip(evals.par_chunks_mut(512)).for_each(|(uv, out)| s.firsts_at(uv, out));
     let mut positions = Vec::with_capacity(evals.len());
     let mut normals = Vec::with_capacity(evals.len());
     for (k, [p, pu, pv]) in evals.iter().enumerate() {
