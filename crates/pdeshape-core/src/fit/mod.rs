@@ -433,14 +433,25 @@ fn local_max(
     ru: (f64, f64),
     rv: (f64, f64),
 ) -> (f64, f64, f64, usize) {
-    let f = |u: f64, v: f64| (b.point(u, v) - s.point(u, v)).scaled_norm();
+    // the patch through its scattered-point evaluation (batches of one point: no row of
+    // cardinal functions computed and cached for a `u` that the ascent never visits again)
+    let point = |u: f64, v: f64| {
+        let mut x = [Vec3::ZERO];
+        s.points_at(&[[u, v]], &mut x);
+        x[0]
+    };
+    let f = |u: f64, v: f64| (b.point(u, v) - point(u, v)).scaled_norm();
     let (mut u, mut v) = (u0, v0);
     let mut fv = f(u, v);
     let mut step = 0.25 * (ru.1 - ru.0).max(rv.1 - rv.0);
     let mut evals = 1;
     for _ in 0..30 {
-        let (ds, dx) = (b.derivatives(u, v, 1, 1), s.derivatives(u, v, 1, 1));
-        // the gradient of |e| is ê·e_u, ê·e_v (ê the unit error); index a·2 + b: [S, S_v, S_u, S_uv]
+        let ds = b.derivatives(u, v, 1, 1);
+        let mut dx = [[Vec3::ZERO; 3]];
+        s.firsts_at(&[[u, v]], &mut dx);
+        // the gradient of |e| is ê·e_u, ê·e_v (ê the unit error); `ds` by index a·2 + b:
+        // [S, S_v, S_u, S_uv], `dx`: [X, X_u, X_v]
+        let dx = [dx[0][0], dx[0][2], dx[0][1]];
         let e = ds[0] - dx[0];
         let n = e.scaled_norm();
         if !(n > 0.0 && n.is_finite()) {

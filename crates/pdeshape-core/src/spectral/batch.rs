@@ -64,17 +64,17 @@ fn joint_tape(data: &[FieldRef]) -> Option<Tape> {
     Some(Tape::compile(&exprs))
 }
 
-/// `g[(c·BLOCK + k)·nj + j] = ∂θʲ g_c` at the block's points `at` (`θ, t` pairs) from the
+/// `g[(c·blk + k)·nj + j] = ∂θʲ g_c` at the block's points `at` (`θ, t` pairs) from the
 /// joint tape, in Taylor series of length `N = nj`.
-fn joint_taylor<const N: usize>(tape: &Tape, at: &[f64], g: &mut [Vec3]) {
+fn joint_taylor<const N: usize>(tape: &Tape, at: &[f64], blk: usize, g: &mut [Vec3]) {
     let mut regs = Vec::new();
     for (k, p) in at.chunks_exact(2).enumerate() {
         let vars = [Taylor::<N>::variable(p[0]), Taylor::constant(p[1])];
         let o = tape.eval(&vars, &Taylor::constant(0.0), &mut regs);
-        for c in 0..g.len() / (BLOCK * N) {
+        for c in 0..g.len() / (blk * N) {
             let (x, y, z) = (&o[3 * c], &o[3 * c + 1], &o[3 * c + 2]);
             for j in 0..N {
-                g[(c * BLOCK + k) * N + j] = Vec3::new(x.derivative(j), y.derivative(j), z.derivative(j));
+                g[(c * blk + k) * N + j] = Vec3::new(x.derivative(j), y.derivative(j), z.derivative(j));
             }
         }
     }
@@ -156,11 +156,14 @@ impl SpectralPatch {
         let mut lrem = vec![0.0; (imax + 1) * nc];
         let mut cs = vec![(1.0, 0.0); m + 1];
         let mut tails = vec![Vec3::ZERO; nc * nj];
-        let mut at = Vec::with_capacity(2 * BLOCK);
+        // the block's length: a call for a few points (a local ascent's steps) allocates
+        // for those alone
+        let blk = BLOCK.min(uv.len()).max(1);
+        let mut at = Vec::with_capacity(2 * blk);
         // the data of a block (none when the series are exact: nothing reads them)
-        let mut g = vec![Vec3::ZERO; if self.exact_series { 0 } else { nc * BLOCK * nj }];
+        let mut g = vec![Vec3::ZERO; if self.exact_series { 0 } else { nc * blk * nj }];
         let scale: [f64; 4] = std::array::from_fn(|j| self.dtheta_dv.powi(j as i32));
-        for (pts, dst) in uv.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        for (pts, dst) in uv.chunks(blk).zip(out.chunks_mut(blk)) {
             crate::cancel::checkpoint();
             let b = pts.len();
             at.clear();
@@ -172,15 +175,15 @@ impl SpectralPatch {
                     for (k, p) in at.chunks_exact(2).enumerate() {
                         let o = tape.eval(p, &0.0, &mut regs);
                         for c in 0..nc {
-                            g[c * BLOCK + k] = Vec3::new(o[3 * c], o[3 * c + 1], o[3 * c + 2]);
+                            g[c * blk + k] = Vec3::new(o[3 * c], o[3 * c + 1], o[3 * c + 2]);
                         }
                     }
                 }
-                (Some(tape), 2) => joint_taylor::<2>(tape, &at, &mut g),
-                (Some(tape), 3) => joint_taylor::<3>(tape, &at, &mut g),
+                (Some(tape), 2) => joint_taylor::<2>(tape, &at, blk, &mut g),
+                (Some(tape), 3) => joint_taylor::<3>(tape, &at, blk, &mut g),
                 _ => {
                     for (c, data) in self.data.iter().enumerate() {
-                        data.derivatives_in_many(&at, 2, 0, nj, &mut g[c * BLOCK * nj..][..b * nj]);
+                        data.derivatives_in_many(&at, 2, 0, nj, &mut g[c * blk * nj..][..b * nj]);
                     }
                 }
             }
@@ -251,7 +254,7 @@ impl SpectralPatch {
                             let (cj, sj) = turn(t, j);
                             sum += (*a * cj + *b * sj) * npow(n, j);
                         }
-                        tails[c * nj + j] = g[(c * BLOCK + k) * nj + j] - sum;
+                        tails[c * nj + j] = g[(c * blk + k) * nj + j] - sum;
                     }
                 }
                 rem.eval(u, imax, None, &cheb, &mut scratch, &mut lrem);
