@@ -42,7 +42,8 @@ enum Kind {
     /// Chebyshev series in `x = 2u − 1`: `mats[k]` holds the combined series of the
     /// `ℓ_i^{(k)}`, `cols × size`, row `c` the series of `F_c^{(k)}` (one dot product with
     /// `T_m(x)` per column, as [`super::UltraCardinal::eval`] does per function).
-    Cheb { size: usize, mats: Vec<Vec<f64>>, lens: Vec<Vec<usize>> },
+    /// `need` is the longest of the `lens`: the terms a point needs.
+    Cheb { size: usize, mats: Vec<Vec<f64>>, lens: Vec<Vec<usize>>, need: usize },
     /// Through [`CardinalSet::eval`].
     Generic,
 }
@@ -175,9 +176,10 @@ impl Combined {
                             .collect()
                     })
                     .collect();
+                let need = lens.iter().flatten().copied().max().unwrap_or(0);
                 let mut at = card.stored_points();
                 at.sort_by(f64::total_cmp);
-                (Kind::Cheb { size, mats, lens }, at)
+                (Kind::Cheb { size, mats, lens, need }, at)
             }
             _ => (Kind::Generic, Vec::new()),
         };
@@ -212,7 +214,8 @@ impl Combined {
     /// functions are Chebyshev series or polynomials in the Chebyshev basis).
     pub fn chebyshev_terms(&self) -> usize {
         match &self.kind {
-            Kind::Cheb { size, .. } => *size,
+            // the longest combined series, not the solve's (its margin is dropped)
+            Kind::Cheb { need, .. } => *need,
             // the basis itself, for values
             Kind::Poly { dim, .. } => *dim,
             _ => 0,
@@ -318,13 +321,13 @@ impl Combined {
                     self.through_cardinals(dim, kmax, mat, scratch, out);
                 }
             }
-            Kind::Cheb { size, mats, lens } => {
+            Kind::Cheb { size, mats, lens, need } => {
                 let size = *size;
-                let tj: &[f64] = if cheb.len() >= size {
-                    &cheb[..size]
+                let tj: &[f64] = if cheb.len() >= *need {
+                    &cheb[..*need]
                 } else {
-                    chebyshev_t(2.0 * u - 1.0, &mut scratch[..size.max(2)]);
-                    &scratch[..size]
+                    chebyshev_t(2.0 * u - 1.0, &mut scratch[..(*need).max(2)]);
+                    &scratch[..*need]
                 };
                 for (k, (mat, lens)) in mats.iter().zip(lens).enumerate().take(kmax + 1) {
                     let dst = &mut out[k * cols..(k + 1) * cols];
