@@ -559,7 +559,8 @@ mod untangle_tests {
         for a in &pairs {
             for b in &pairs {
                 let (ta, tb) = (a.0.atan2(a.1), b.0.atan2(b.1));
-                if (ta - tb).abs() > 4.0 * f64::EPSILON * ta.abs().max(tb.abs()) {
+                // NaN-free here (finite pairs), and a NaN would fail the comparison
+                if (ta - tb).abs() > 4.0 * f64::EPSILON * crate::num::max_nan(ta.abs(), tb.abs()) {
                     assert_eq!(angle_below(*a, *b), ta < tb, "{a:?} against {b:?}");
                 }
             }
