@@ -126,6 +126,10 @@ fn bad_meshes_refused() {
         ("dup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 1\n".into(), "triangle 1 repeats triangle 0"),
         ("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n".into(), "triangle 0 is degenerate (zero area)"),
         ("index.obj", "v 0 0 0\nf 1 2 3\n".into(), "vertex index 2 is out of range"),
+        // the reader's line numbers: formatted only when a line is refused
+        ("short.obj", "v 0 0 0\nv 1 0\n".into(), "short.obj:2: a vertex needs 3 coordinates, found 2"),
+        ("word.obj", "# c\nv 0 0 0\nv 1 x 0\n".into(), "word.obj:3: `x` is not a number"),
+        ("edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n".into(), "edge.obj:5: a face of 2 vertices"),
         ("cut.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n".into(), "vertex 2: the file ends before property `x`"),
     ];
     for (name, text, want) in cases {

@@ -128,9 +128,16 @@ impl Reader<'_> {
     }
 
     /// Splits a polygon into a fan of triangles.
-    fn polygon(&mut self, idx: &[u32], out: &mut Vec<[u32; 3]>, place: String) -> Result<(), MeshError> {
+    /// `place` is formatted only for an error: a face is read once a line and most lines
+    /// are fine.
+    fn polygon(
+        &mut self,
+        idx: &[u32],
+        out: &mut Vec<[u32; 3]>,
+        place: impl FnOnce() -> String,
+    ) -> Result<(), MeshError> {
         if idx.len() < 3 {
-            return Err(self.err(place, format!("a face of {} vertices", idx.len())));
+            return Err(self.err(place(), format!("a face of {} vertices", idx.len())));
         }
         if idx.len() > 3 {
             self.split += 1;
@@ -148,26 +155,25 @@ impl Reader<'_> {
         })?;
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
+        // One buffer for every face's indices: no allocation a line.
+        let mut idx = Vec::new();
         for (ln, line) in text.lines().enumerate() {
             let place = || (ln + 1).to_string();
-            let mut it = line.split_whitespace();
+            let mut it = line.split_ascii_whitespace();
             match it.next() {
                 Some("v") => {
-                    let c: Vec<&str> = it.collect();
-                    if c.len() < 3 {
-                        return Err(self.err(place(), format!("a vertex needs 3 coordinates, found {}", c.len())));
-                    }
                     let mut p = [0.0; 3];
-                    for k in 0..3 {
-                        p[k] = c[k]
-                            .parse::<f64>()
-                            .map_err(|_| self.err(place(), format!("`{}` is not a number", c[k])))?;
+                    for (k, slot) in p.iter_mut().enumerate() {
+                        let Some(c) = it.next() else {
+                            return Err(self.err(place(), format!("a vertex needs 3 coordinates, found {k}")));
+                        };
+                        *slot = c.parse::<f64>().map_err(|_| self.err(place(), format!("`{c}` is not a number")))?;
                     }
                     positions.push(Vec3::from_array(p));
                     self.cap((positions.len() + triangles.len()) as u128, "the mesh's vertices and faces")?;
                 }
                 Some("f") => {
-                    let mut idx = Vec::new();
+                    idx.clear();
                     for tok in it {
                         let first = tok.split('/').next().unwrap_or("");
                         let i: i64 =
@@ -182,7 +188,7 @@ impl Reader<'_> {
                         }
                         idx.push(k as u32);
                     }
-                    self.polygon(&idx, &mut triangles, place())?;
+                    self.polygon(&idx, &mut triangles, place)?;
                     self.cap((positions.len() + triangles.len()) as u128, "the mesh's vertices and faces")?;
                 }
                 _ => {}
@@ -411,7 +417,7 @@ impl Reader<'_> {
                 if e == vi {
                     positions.push(Vec3::from_array(p));
                 } else if e == fi {
-                    self.polygon(&idx, &mut triangles, place())?;
+                    self.polygon(&idx, &mut triangles, place)?;
                 }
             }
         }
