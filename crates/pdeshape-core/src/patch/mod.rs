@@ -189,17 +189,28 @@ pub fn check_conditions(s: &dyn Surface, conds: &[Condition], t: f64, samples: u
     }
     let g = s.grid(&us, &vs);
     let at = |u: f64, j: usize| &g[us.iter().position(|x| *x == u).expect("a grid row") * vs.len() + j];
+    // each condition's data at every sample in one call (`Field::derivatives_in_many`:
+    // data carried on another patch evaluate it in a batch)
+    let vt: Vec<f64> = vs.iter().flat_map(|&v| [v, t]).collect();
+    let data: Vec<Vec<Vec3>> = conds
+        .iter()
+        .map(|c| {
+            let mut out = vec![Vec3::ZERO; vs.len()];
+            c.data.derivatives_in_many(&vt, 2, 0, 1, &mut out);
+            out
+        })
+        .collect();
     let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut hi = -lo;
     let mut max_abs: f64 = 0.0;
     for (j, &v) in vs.iter().enumerate() {
-        for c in conds {
+        for (c, g) in conds.iter().zip(&data) {
             let x = match c.order {
                 0 => at(c.u, j)[0],
                 1 => at(c.u, j)[1],
                 k => s.u_derivative(c.u, v, k),
             };
-            let e = (x - c.data.eval(&[v, t])).scaled_norm();
+            let e = (x - g[j]).scaled_norm();
             max_abs = crate::num::max_nan(max_abs, e);
             if c.order == 0 {
                 lo = lo.min(x);

@@ -742,17 +742,54 @@ impl SpectralPatch {
         out
     }
 
+    /// The columns' `(cos nθ, sin nθ)` and tails ([`tails_with`](Self::tails_with)'s
+    /// numbers), each unproved datum evaluated at all the columns' `θ` in blocks of
+    /// [`DATA_BLOCK`] through `Field::derivatives_in_many` (data carried on another patch —
+    /// a fin's root curve on the body — evaluate that patch in a batch there).
     fn grid_columns(&self, vs: &[f64], jmax: usize) -> Vec<GridColumn> {
-        vs.par_iter()
-            .map(|&v| {
-                let th = self.theta(v);
+        let ths: Vec<f64> = vs.iter().map(|&v| self.theta(v)).collect();
+        let k = jmax + 1;
+        let at: Vec<f64> = ths.iter().flat_map(|&th| [th, self.time]).collect();
+        let data: Vec<Option<Vec<Vec3>>> = if self.exact_series {
+            Vec::new()
+        } else {
+            self.data
+                .iter()
+                .zip(&self.exact)
+                .map(|(g, &exact)| {
+                    (!exact).then(|| {
+                        let mut d = vec![Vec3::ZERO; ths.len() * k];
+                        at.par_chunks(2 * DATA_BLOCK)
+                            .zip(d.par_chunks_mut(k * DATA_BLOCK))
+                            .for_each(|(a, o)| g.derivatives_in_many(a, 2, 0, k, o));
+                        d
+                    })
+                })
+                .collect()
+        };
+        ths.par_iter()
+            .enumerate()
+            .map(|(c, &th)| {
                 let cs = self.trig(th);
-                let tails = self.tails_with(th, &cs, jmax);
+                let tails = data
+                    .iter()
+                    .zip(&self.series)
+                    .map(|(d, s)| match d {
+                        None => vec![Vec3::ZERO; k],
+                        Some(d) => {
+                            let series = s.derivatives_from(&cs, jmax);
+                            d[c * k..(c + 1) * k].iter().zip(&series).map(|(&x, &f)| x - f).collect()
+                        }
+                    })
+                    .collect();
                 GridColumn { cs, tails }
             })
             .collect()
     }
 }
+
+/// Grid columns whose data one `Field::derivatives_in_many` call evaluates.
+const DATA_BLOCK: usize = 64;
 
 mod batch;
 #[cfg(test)]

@@ -78,6 +78,41 @@ impl Field for CurveOnSurface {
         VecJet(out)
     }
 
+    /// Values (`k = 1`: a condition check's thousand `t`) and values with first derivatives
+    /// (`k = 2`: a grid's columns, `g′ = X_u C_u′ + X_v C_v′`) go through the patch's batched
+    /// [`Surface::points_at`] / [`Surface::firsts_at`]: the points' `u` are all new, so one
+    /// at a time each would compute a row of every mode afresh. Equal to the pointwise
+    /// numbers to round-off. Higher derivatives go point by point through [`jet`](Self::jet).
+    fn derivatives_in_many(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
+        let ts = at.chunks_exact(stride).map(|p| p[0]);
+        match (slot, k) {
+            (0, 1) => {
+                let uv: Vec<[f64; 2]> = ts.map(|t| self.curve.point(t)).collect();
+                self.surface.points_at(&uv, &mut out[..uv.len()]);
+            }
+            (0, 2) => {
+                let c: Vec<[[f64; 2]; 2]> = ts
+                    .map(|t| {
+                        let d = self.curve.derivatives(t, 1);
+                        [d[0], d[1]]
+                    })
+                    .collect();
+                let uv: Vec<[f64; 2]> = c.iter().map(|d| d[0]).collect();
+                let mut x = vec![[Vec3::ZERO; 3]; uv.len()];
+                self.surface.firsts_at(&uv, &mut x);
+                for ((o, x), d) in out.chunks_exact_mut(2).zip(&x).zip(&c) {
+                    o[0] = x[0];
+                    o[1] = x[1] * d[1][0] + x[2] * d[1][1];
+                }
+            }
+            _ => {
+                for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
+                    self.derivatives_in(p, slot, o);
+                }
+            }
+        }
+    }
+
     fn is_constant_in(&self, slot: usize) -> bool {
         slot > 0
     }

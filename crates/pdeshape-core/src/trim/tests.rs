@@ -218,6 +218,31 @@ fn curve_on_surface_has_exact_derivatives() {
     assert!((j.derivative([2, 0, 0]).z - z2).abs() < 1e-13);
     assert!((j.derivative([2, 0, 0]).x - ddu).abs() < 1e-14);
 
+    // in a batch (`derivatives_in_many`, the path of condition checks and grid columns):
+    // values (k = 1) and values with g′ (k = 2), by hand at 97 t, and the other counts and
+    // slots through the jets, bit for bit
+    let ts: Vec<f64> = (0..97).map(|i| -3.0 + 0.0713 * i as f64).collect();
+    let at: Vec<f64> = ts.iter().flat_map(|&t| [t, 0.25]).collect();
+    for k in 1..=3 {
+        let mut out = vec![Vec3::new(f64::NAN, 0.0, 0.0); ts.len() * k];
+        g.derivatives_in_many(&at, 2, 0, k, &mut out);
+        for (i, &t) in ts.iter().enumerate() {
+            let (u, v) = (0.5 + 0.2 * t.cos(), 0.4 + 0.1 * t.sin());
+            let (du, dv) = (-0.2 * t.sin(), 0.1 * t.cos());
+            // position and g′ = (u′, v′, 2u u′ v + u² v′), rounding of a few products
+            let want = [Vec3::new(u, v, u * u * v), Vec3::new(du, dv, 2.0 * u * du * v + u * u * dv)];
+            for (d, w) in want.iter().enumerate().take(k.min(2)) {
+                let e = (out[i * k + d] - *w).norm();
+                assert!(e < 4e-16, "k = {k}, t = {t}, derivative {d}: {e:e}");
+            }
+            if k == 3 {
+                let mut one = [Vec3::ZERO; 3];
+                g.derivatives_in(&at[2 * i..2 * i + 2], 0, &mut one);
+                assert_eq!(&out[3 * i..3 * i + 3], &one[..], "k = 3 is the pointwise path");
+            }
+        }
+    }
+
     // the host normal is the paraboloid's, X_u × X_v = (−2uv, −u², 1), at C(t)
     let h = g.host_normal(&[t]).unwrap();
     assert!((h - Vec3::new(-2.0 * u * v, -u * u, 1.0)).norm() < 1e-15, "{h:?}");
