@@ -102,12 +102,7 @@ pub trait Field: Send + Sync + Debug {
     /// same numbers as one call per point; fields override it to share work between the
     /// points (expression fields keep one tape workspace for the batch).
     fn derivatives_in_many(&self, at: &[f64], stride: usize, slot: usize, k: usize, out: &mut [Vec3]) {
-        if k == 0 {
-            return;
-        }
-        for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
-            self.derivatives_in(p, slot, o);
-        }
+        derivatives_point_by_point(self, at, stride, slot, k, out)
     }
 
     /// True when the field does not depend on slot `slot` (e.g. time for a B-spline).
@@ -139,6 +134,24 @@ pub trait Field: Send + Sync + Debug {
             let free = (1..vars.len()).all(|i| !e.depends_on(i));
             free.then(|| crate::expr::trig_degree(e, 0)).flatten().map(|d| acc.max(d))
         })
+    }
+}
+
+/// [`Field::derivatives_in_many`] as one [`Field::derivatives_in`] call a point: the
+/// default, and what overrides fall back to for the counts they do not batch.
+pub fn derivatives_point_by_point<F: Field + ?Sized>(
+    f: &F,
+    at: &[f64],
+    stride: usize,
+    slot: usize,
+    k: usize,
+    out: &mut [Vec3],
+) {
+    if k == 0 {
+        return;
+    }
+    for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
+        f.derivatives_in(p, slot, o);
     }
 }
 

@@ -478,18 +478,39 @@ impl SpectralPatch {
         if self.exact_series {
             return Vec::new();
         }
-        self.data
+        let data: Vec<Option<Vec<Vec3>>> = self
+            .data
             .iter()
-            .zip(&self.series)
             .zip(&self.exact)
-            .map(|((g, s), &exact)| {
-                if exact {
-                    return vec![Vec3::ZERO; jmax + 1];
+            .map(|(g, &exact)| {
+                (!exact).then(|| {
+                    let mut d = vec![Vec3::ZERO; jmax + 1];
+                    g.derivatives_in(&[theta, self.time], 0, &mut d);
+                    d
+                })
+            })
+            .collect();
+        self.tails_from(cs, jmax, |c| data[c].as_deref())
+    }
+
+    /// The tails `r_c^{(j)} = g_c^{(j)} − (series of g_c)^{(j)}` at a `θ` with
+    /// `cs = trig(θ)`, from each datum's derivatives `data(c)` there (`j = 0 … jmax`);
+    /// `None` for a datum proved a finite series, whose tails are zero.
+    fn tails_from<'a>(
+        &self,
+        cs: &[(f64, f64)],
+        jmax: usize,
+        data: impl Fn(usize) -> Option<&'a [Vec3]>,
+    ) -> Vec<Vec<Vec3>> {
+        self.series
+            .iter()
+            .enumerate()
+            .map(|(c, s)| match data(c) {
+                None => vec![Vec3::ZERO; jmax + 1],
+                Some(d) => {
+                    let series = s.derivatives_from(cs, jmax);
+                    d.iter().zip(&series).map(|(&x, &f)| x - f).collect()
                 }
-                let mut d = vec![Vec3::ZERO; jmax + 1];
-                g.derivatives_in(&[theta, self.time], 0, &mut d);
-                let series = s.derivatives_from(cs, jmax);
-                d.iter().zip(&series).map(|(&x, &f)| x - f).collect()
             })
             .collect()
     }
@@ -771,17 +792,11 @@ impl SpectralPatch {
             .enumerate()
             .map(|(c, &th)| {
                 let cs = self.trig(th);
-                let tails = data
-                    .iter()
-                    .zip(&self.series)
-                    .map(|(d, s)| match d {
-                        None => vec![Vec3::ZERO; k],
-                        Some(d) => {
-                            let series = s.derivatives_from(&cs, jmax);
-                            d[c * k..(c + 1) * k].iter().zip(&series).map(|(&x, &f)| x - f).collect()
-                        }
-                    })
-                    .collect();
+                let tails = if self.exact_series {
+                    Vec::new()
+                } else {
+                    self.tails_from(&cs, jmax, |i| data[i].as_ref().map(|d| &d[c * k..(c + 1) * k]))
+                };
                 GridColumn { cs, tails }
             })
             .collect()

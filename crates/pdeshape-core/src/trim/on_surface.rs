@@ -105,11 +105,7 @@ impl Field for CurveOnSurface {
                     o[1] = x[1] * d[1][0] + x[2] * d[1][1];
                 }
             }
-            _ => {
-                for (p, o) in at.chunks_exact(stride).zip(out.chunks_exact_mut(k)) {
-                    self.derivatives_in(p, slot, o);
-                }
-            }
+            _ => crate::data::derivatives_point_by_point(self, at, stride, slot, k, out),
         }
     }
 

@@ -243,6 +243,9 @@ fn curve_on_surface_has_exact_derivatives() {
         }
     }
 
+    // no derivatives asked: nothing written, no panic (as every field's default)
+    g.derivatives_in_many(&at, 2, 0, 0, &mut []);
+
     // the host normal is the paraboloid's, X_u × X_v = (−2uv, −u², 1), at C(t)
     let h = g.host_normal(&[t]).unwrap();
     assert!((h - Vec3::new(-2.0 * u * v, -u * u, 1.0)).norm() < 1e-15, "{h:?}");
