@@ -11,7 +11,7 @@ use pdeshape_core::limits::Limits;
 use pdeshape_core::mesh::Mesh;
 use pdeshape_core::num::max_nan;
 use pdeshape_core::trimesh::{
-    LoopFillOptions, LoopKind, MeshLoop, TriMesh, adjacency, crossings, crossings_with, dihedral_angles,
+    FillShape, LoopFillOptions, LoopKind, MeshLoop, TriMesh, adjacency, crossings, crossings_with, dihedral_angles,
     fill_loop_with, quantile,
 };
 use serde::Serialize;
@@ -108,12 +108,16 @@ pub struct MeshFillReport {
     pub g2: f64,
     /// The largest dihedral angle across the former border (radians).
     pub seam_dihedral: f64,
-    /// The fill's fullness (its cross tangent against the loop's mean radius) and pole
-    /// height (factor on the least-bending pole's offset), chosen for least Willmore
-    /// energy.
+    /// Which fill: `"disc"` (the disc fill, `Δ³X = 0` in the unit disc) or `"strip"` (the
+    /// strip fill closed in a pole, where the disc fill is not possible or folds).
+    pub shape: &'static str,
+    /// Its fullness (the disc fill's radial derivative scale; the strip fill's cross
+    /// tangent against the loop's mean radius), chosen for least Willmore energy.
     pub fullness: f64,
-    /// Pole height.
-    pub height: f64,
+    /// The disc fill's `μ` (`μ X_r` added to `X_rr`).
+    pub mu: Option<f64>,
+    /// The strip fill's pole height (factor on the least-bending pole's offset).
+    pub height: Option<f64>,
     /// Its Willmore energy `∫ H² dA`.
     pub willmore: f64,
     /// The shortest and longest new edge over the local median edge length.
@@ -169,8 +173,21 @@ pub fn fill_mesh_holes(
             gap: f.continuity.gap,
             g2: f.continuity.g2,
             seam_dihedral: f.seam_dihedral,
-            fullness: f.fullness,
-            height: f.height,
+            shape: match f.shape {
+                FillShape::Disc { .. } => "disc",
+                FillShape::Strip { .. } => "strip",
+            },
+            fullness: match f.shape {
+                FillShape::Disc { fullness, .. } | FillShape::Strip { fullness, .. } => fullness,
+            },
+            mu: match f.shape {
+                FillShape::Disc { mu, .. } => Some(mu),
+                FillShape::Strip { .. } => None,
+            },
+            height: match f.shape {
+                FillShape::Disc { .. } => None,
+                FillShape::Strip { height, .. } => Some(height),
+            },
             willmore: f.willmore,
             edge_ratio: f.edge_ratio,
         });

@@ -228,8 +228,13 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
         }
         for f in &reports {
             let g2 = if o.order == 6 { format!(", curvature gap {:.3e}", f.g2) } else { String::new() };
+            let shape = match (f.mu, f.height) {
+                (Some(mu), _) => format!("disc fill, fullness {:.3}, μ {mu:.3}", f.fullness),
+                (_, Some(h)) => format!("strip fill, fullness {:.3}, pole height {h:.3}", f.fullness),
+                _ => String::new(),
+            };
             eprintln!(
-                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; fullness {:.3}, pole height {:.3} (Willmore energy {:.4e}); seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
+                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; {shape} (Willmore energy {:.4e}); seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
                 f.index,
                 o.order,
                 f.new_vertices,
@@ -239,8 +244,6 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
                 f.collar_points,
                 f.g1,
                 f.gap,
-                f.fullness,
-                f.height,
                 f.willmore,
                 f.seam_dihedral,
                 r.dihedral_p99,

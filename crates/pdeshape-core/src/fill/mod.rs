@@ -52,6 +52,7 @@
 mod crease;
 mod curve;
 mod data;
+pub mod disc;
 mod family;
 mod foot;
 mod foot_series;
@@ -196,6 +197,32 @@ pub struct Fill {
     position: Arc<LoopData>,
     report: FillReport,
     t: f64,
+}
+
+/// Points of a grid of normals (`nu` rows, each closed around `nv` points) whose normal
+/// vanishes (below 1e-9 of the median length), is not finite, or makes a cosine of at most
+/// `min_cos` with a neighbour's (next in the row, or in the next row).
+pub fn count_turns(normals: &[Vec3], nu: usize, nv: usize, min_cos: f64) -> usize {
+    let mut lengths: Vec<f64> = normals.iter().map(|n| n.norm()).collect();
+    lengths.sort_by(f64::total_cmp);
+    let tiny = 1e-9 * lengths[lengths.len() / 2];
+    let at = |i: usize, j: usize| normals[i * nv + j % nv];
+    let mut folds = 0;
+    for i in 0..nu {
+        for j in 0..nv {
+            let n = at(i, j);
+            // the cosine at most min_cos, NaN included
+            let against = |m: Vec3| {
+                let c = n.dot(m) / (n.norm() * m.norm());
+                c.is_nan() || c <= min_cos
+            };
+            let flips = (i + 1 < nu && against(at(i + 1, j))) || against(at(i, j + 1));
+            if flips || n.norm().is_nan() || n.norm() <= tiny {
+                folds += 1;
+            }
+        }
+    }
+    folds
 }
 
 /// A vector of NaNs: what a degenerate direction becomes in the measures.
@@ -957,26 +984,7 @@ impl Fill {
         let vs: Vec<f64> = (0..nv).map(|j| TAU * (j as f64 + 0.5) / nv as f64).collect();
         let g = self.patch.grid(&us, &vs);
         let normals: Vec<Vec3> = g.iter().map(|d| d[1].cross(d[2])).collect();
-        let mut lengths: Vec<f64> = normals.iter().map(|n| n.norm()).collect();
-        lengths.sort_by(f64::total_cmp);
-        let tiny = 1e-9 * lengths[lengths.len() / 2];
-        let at = |i: usize, j: usize| normals[i * nv + j % nv];
-        let mut folds = 0;
-        for i in 0..nu {
-            for j in 0..nv {
-                let n = at(i, j);
-                // the cosine at most min_cos, NaN included
-                let against = |m: Vec3| {
-                    let c = n.dot(m) / (n.norm() * m.norm());
-                    c.is_nan() || c <= min_cos
-                };
-                let flips = (i + 1 < nu && against(at(i + 1, j))) || against(at(i, j + 1));
-                if flips || n.norm().is_nan() || n.norm() <= tiny {
-                    folds += 1;
-                }
-            }
-        }
-        folds
+        count_turns(&normals, nu, nv, min_cos)
     }
 
     /// The fill's own continuity, measured on an `nu × nv` grid (`u ≤ 0.98`, away from the

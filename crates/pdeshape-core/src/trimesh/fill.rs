@@ -7,9 +7,14 @@
 //! a smooth curve `s = σ̄(w)` in the collar's domain just inside the hole (a spline on the
 //! spine's breakpoints fitted to `s_i − 0.87 h` at the loop's vertices, lowered as a whole
 //! to stay `0.4 h` beyond every loop vertex and `max(0.25 h, 0.35 h_l)` beyond every band
-//! vertex, `h_l` the local median edge length where it stands), cut
-//! into four pieces of equal `w`-length; its cross tangent points away from the mesh, and
-//! it meets the collar G1 (order 4) or G2 (order 6) along that curve by construction.
+//! vertex, `h_l` the local median edge length where it stands). The fill meets the collar
+//! G1 (order 4) or G2 (order 6) along that curve by construction. It is the disc fill
+//! ([`super::disc`]: `Δ²X = 0` or `Δ³X = 0` in the unit disc, whose circle is the curve
+//! parametrised by the affine angle of a fitted ellipse; it reproduces a quadratic surface
+//! over an elliptical hole, where the strip fill lay 1.5e-3 off the saddle of the tests)
+//! wherever the curve is star-shaped about that ellipse and the fill does not fold; else
+//! the strip fill ([`crate::fill`], the curve cut into four pieces of equal `w`-length, its
+//! cross tangent pointing away from the mesh, closed in a pole).
 //!
 //! **The band.** Between the loop and the fill's boundary lies a band of the collar
 //! itself, about one edge wide. Its triangles on the loop's edges have their apexes over
@@ -38,11 +43,12 @@
 use super::band::{Band, BandInput, BandVertex, SHORTEST, apex_band};
 use super::collar::{CollarError, CollarFit, DomainLine, adjacency, fit_collar, triangles_on_loop};
 use super::crossing::crossing_free;
+use super::disc::DiscSurface;
 use super::flip::flip_to_delaunay;
 use super::{LoopKind, MeshLoop, TriMesh, position};
 use crate::Vec3;
 use crate::data::FieldRef;
-use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, Fill, FillEdge, FillError, FillFamily, FillOptions, Host};
+use crate::fill::{AlongCurve, DomainCurve, EdgeContinuity, FillEdge, FillError, FillFamily, FillOptions, Host};
 use crate::num::max_nan;
 use crate::patch::Surface;
 use faer::linalg::solvers::Solve;
@@ -59,11 +65,14 @@ pub struct LoopFillOptions {
     /// Most new vertices of one fill (the `vertices` cap: a loop long against its edges
     /// would otherwise ask for a mesh of any size).
     pub max_vertices: usize,
+    /// Fill by the disc fill where the loop allows it (`true`, the default), else by the
+    /// strip fill (see [`FillShape`]).
+    pub disc: bool,
 }
 
 impl Default for LoopFillOptions {
     fn default() -> Self {
-        LoopFillOptions { order: 4, rings: 3, max_vertices: 4_000_000 }
+        LoopFillOptions { order: 4, rings: 3, max_vertices: 4_000_000, disc: true }
     }
 }
 
@@ -71,14 +80,9 @@ impl Default for LoopFillOptions {
 pub struct LoopFill {
     /// The collar and its fit.
     pub fit: CollarFit,
-    /// The fill.
-    pub fill: Fill,
-    /// Its fullness (cross tangent against the loop's mean radius) and pole height (factor
-    /// on the least-bending pole's offset from the centroid), chosen for least Willmore
-    /// energy (see [`fill_loop`]).
-    pub fullness: f64,
-    /// Its pole height.
-    pub height: f64,
+    /// Which fill, and its free parameters, chosen for least Willmore energy (see
+    /// [`fill_loop`]).
+    pub shape: FillShape,
     /// Its Willmore energy `∫ H² dA`.
     pub willmore: f64,
     /// New vertices, to be appended to the mesh's (their indices start at the `base`
@@ -101,6 +105,132 @@ pub struct LoopFill {
     /// other (false for the last way of stitching, which is kept unchecked: the caller
     /// checks it, [`super::crossings`]).
     pub crossing_free: bool,
+}
+
+/// Which fill a loop got, with the parameters that G1 (G2) leaves free, as chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FillShape {
+    /// The disc fill ([`super::disc`]): `fullness` scales its radial derivative at the
+    /// loop, `mu` times it is added to the second.
+    Disc {
+        /// `f`.
+        fullness: f64,
+        /// `μ`.
+        mu: f64,
+    },
+    /// The strip fill closed in a pole ([`crate::fill`]), where the disc fill is not
+    /// possible (a loop not star-shaped about its fitted ellipse) or folds.
+    Strip {
+        /// The cross tangent's length against the loop's mean radius.
+        fullness: f64,
+        /// The factor on the least-bending pole's offset from the centroid.
+        height: f64,
+        /// Why not the disc fill: the number of its grid points that turned over (0 when
+        /// it could not be set up, or was not asked for).
+        disc_folds: usize,
+    },
+}
+
+/// A loop's fill surface in the strip chart `(u, v)`: `u = 0` the boundary line, `u = 1`
+/// the pole (centre), `v = 2π (w − w₀)/L`.
+enum Filled {
+    Strip(Arc<crate::spectral::SpectralPatch>),
+    Disc(Box<DiscSurface>),
+}
+
+impl Filled {
+    /// Values on the grid `us × vs`.
+    fn values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
+        match self {
+            Filled::Strip(p) => p.grid_values(us, vs),
+            Filled::Disc(d) => d.values(us, vs),
+        }
+    }
+
+    /// The point at `u = 1`.
+    fn pole(&self) -> Vec3 {
+        match self {
+            Filled::Strip(p) => p.point(1.0, 0.0),
+            Filled::Disc(d) => d.pole(),
+        }
+    }
+}
+
+/// What a fill's construction hands the mesher: the surface, its shape and parameters,
+/// its Willmore energy, its continuity against the collar.
+type Chosen = (Filled, FillShape, f64, EdgeContinuity);
+
+/// The disc fill's member of least Willmore energy over `(f, μ)`, or the number of its grid
+/// points that turn over.
+fn disc_member(mut disc: DiscSurface, order: usize) -> Result<Chosen, usize> {
+    let (rs, wr) = crate::solid::gauss_legendre(16);
+    let ts: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
+    let grids = disc.part_grids(&rs, &ts);
+    let search = Search {
+        start: [1.0, 0.0],
+        bounds: [(0.5, 2.0), (-3.0, 3.0)],
+        delta: [0.15, if order >= 6 { 0.5 } else { 0.0 }],
+    };
+    let ([f, mu], energy) =
+        fairest(&search, |[f, mu]| willmore(&DiscSurface::member_grid(&grids, f, mu), &wr, ts.len()));
+    disc.choose(f, mu);
+    let folds = disc.folds(32, 64);
+    if folds > 0 {
+        return Err(folds);
+    }
+    let continuity = disc.continuity(256);
+    Ok((Filled::Disc(Box::new(disc)), FillShape::Disc { fullness: f, mu }, energy, continuity))
+}
+
+/// The strip fill of least Willmore energy over fullness and pole height.
+fn strip_fill(
+    fit: &CollarFit,
+    line: &DomainLine,
+    o: &LoopFillOptions,
+    disc_folds: usize,
+) -> Result<Chosen, LoopFillError> {
+    let (period, w0) = (fit.period, fit.params[0].1);
+    let along = AlongCurve {
+        host: Host::Field(Arc::new(fit.collar.clone())),
+        curve: DomainCurve::Field(Arc::new(line.clone())),
+    };
+    // the fills of several fullnesses ask the collar at the same points: kept per point
+    // and each in several shapes: orders 4 and 6 ask for up to 2 derivatives across and
+    // up to 3 and 4 along (seen), so a point's jet is computed once in that shape
+    let cover = crate::jet::JetShape::new(&[2, o.order / 2 + 1]);
+    let surface: FieldRef = Arc::new(crate::data::MemoField::covering(Arc::new(along), cover));
+    // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
+    let edges: Vec<FillEdge> = (0..4)
+        .map(|k| FillEdge {
+            surface: surface.clone(),
+            s0: 0.0,
+            w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
+            fullness: 1.0,
+            side: Some(1.0),
+        })
+        .collect();
+    // every fill of the search from the solves of one (`FillFamily`), its energy on the
+    // Willmore rule's grid
+    let (us, wu) = crate::solid::gauss_legendre(16);
+    let vs: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
+    // the collar (periodic cubic splines in `w`, a cubic in `s`) and the boundary line (a
+    // periodic cubic spline) are C2, so the reparametrised collar has no crease for
+    // `crease::creases` to look for (512 jets an edge)
+    let options = FillOptions { order: o.order, split_creases: false, ..FillOptions::default() };
+    let family = FillFamily::new(&edges, &options, &us, &vs)?;
+    let search = Search { start: [1.0, 1.0], bounds: [(0.5, 2.0), (0.0, 4.0)], delta: [0.15, 0.4] };
+    let ([fullness, height], energy) = fairest(&search, |[f, h]| willmore(&family.grid2(f, h), &wu, vs.len()));
+    let fill = family.fill(fullness, height)?;
+    if !fill.report().dropped_edges.is_empty() {
+        return Err(LoopFillError::Unstitched);
+    }
+    let folds = fill.folds(32, 64);
+    if folds > 0 {
+        return Err(LoopFillError::Folds(folds));
+    }
+    let continuity = fill.edge_continuity(64);
+    let shape = FillShape::Strip { fullness, height, disc_folds };
+    Ok((Filled::Strip(fill.patch().clone()), shape, energy, continuity))
 }
 
 /// Why a loop is not filled.
@@ -139,9 +269,11 @@ pub enum LoopFillError {
     Unstitched,
 }
 
-/// Fills loop `lp` of `m`; the new vertices are numbered from `base`. Of the fills that
-/// meet the collar G1 (G2), differing in the length of their cross tangent and the height
-/// of their pole, the one of least Willmore energy is taken (`fairest`).
+/// Fills loop `lp` of `m`; the new vertices are numbered from `base`. The disc fill where
+/// the loop is star-shaped about its fitted ellipse and the fill does not fold, else the
+/// strip fill ([`FillShape`]); of the fills of either kind that meet the collar G1 (G2),
+/// differing in the two parameters G1 (G2) leaves free, the one of least Willmore energy is
+/// taken (`fairest`).
 pub fn fill_loop(m: &TriMesh, lp: &MeshLoop, base: u32, o: &LoopFillOptions) -> Result<LoopFill, LoopFillError> {
     fill_loop_with(m, &adjacency(m), lp, base, o)
 }
@@ -201,55 +333,24 @@ pub fn fill_loop_with(
     };
     let band = apex_band(&band_input, base);
     let line = boundary_line(&fit, h, band.as_ref().map_or(&[][..], |b| &b.vertices));
-    let along = AlongCurve {
-        host: Host::Field(Arc::new(fit.collar.clone())),
-        curve: DomainCurve::Field(Arc::new(line.clone())),
+    let disc = o.disc.then(|| DiscSurface::new(&fit.collar, &line, period, w0, o.order)).flatten();
+    let (filled, shape, willmore_energy, continuity) = match disc {
+        Some(disc) => match disc_member(disc, o.order) {
+            Ok(chosen) => chosen,
+            Err(folds) => strip_fill(&fit, &line, o, folds)?,
+        },
+        None => strip_fill(&fit, &line, o, 0)?,
     };
-    // the fills of several fullnesses ask the collar at the same points: kept per point
-    // and each in several shapes: orders 4 and 6 ask for up to 2 derivatives across and
-    // up to 3 and 4 along (seen), so a point's jet is computed once in that shape
-    let cover = crate::jet::JetShape::new(&[2, o.order / 2 + 1]);
-    let surface: FieldRef = Arc::new(crate::data::MemoField::covering(Arc::new(along), cover));
-    // the reparametrised collar's σ grows along (−1, σ̄′) in (s, w): into the hole
-    let edges: Vec<FillEdge> = (0..4)
-        .map(|k| FillEdge {
-            surface: surface.clone(),
-            s0: 0.0,
-            w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
-            fullness: 1.0,
-            side: Some(1.0),
-        })
-        .collect();
-    // every fill of the search from the solves of one (`FillFamily`), its energy on the
-    // Willmore rule's grid
-    let (us, wu) = crate::solid::gauss_legendre(16);
-    let vs: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
-    // the collar (periodic cubic splines in `w`, a cubic in `s`) and the boundary line (a
-    // periodic cubic spline) are C2, so the reparametrised collar has no crease for
-    // `crease::creases` to look for (512 jets an edge)
-    let options = FillOptions { order: o.order, split_creases: false, ..FillOptions::default() };
-    let family = FillFamily::new(&edges, &options, &us, &vs)?;
-    let ([fullness, height], willmore_energy) = fairest(|[f, h]| willmore(&family.grid2(f, h), &wu, vs.len()));
-    let fill = family.fill(fullness, height)?;
-    if !fill.report().dropped_edges.is_empty() {
-        return Err(LoopFillError::Unstitched);
-    }
-    let folds = fill.folds(32, 64);
-    if folds > 0 {
-        return Err(LoopFillError::Folds(folds));
-    }
-    let continuity = fill.edge_continuity(64);
-    let patch = fill.patch().clone();
-    // arc length from the loop to the pole, averaged over v (on a grid: the patch's
-    // grid evaluation shares its work across rows and columns, scattered points do not)
+    // arc length from the loop to the pole, averaged over v (on a grid: the fills' grid
+    // evaluations share their work across rows and columns, scattered points do not)
     let (nsu, nsv) = (65, 16);
     let us: Vec<f64> = (0..nsu).map(|i| i as f64 / (nsu - 1) as f64).collect();
     let vs: Vec<f64> = (0..nsv).map(|j| TAU * j as f64 / nsv as f64).collect();
-    let g = patch.grid(&us, &vs);
+    let g = filled.values(&us, &vs);
     let mut arc = vec![0.0; nsu];
     for j in 0..nsv {
         for i in 1..nsu {
-            arc[i] += (g[i * nsv + j][0] - g[(i - 1) * nsv + j][0]).norm() / nsv as f64;
+            arc[i] += (g[i * nsv + j] - g[(i - 1) * nsv + j]).norm() / nsv as f64;
         }
     }
     for i in 1..nsu {
@@ -277,7 +378,7 @@ pub fn fill_loop_with(
     let ring_us: Vec<f64> =
         (0..rings).map(|j| if j == 0 { 0.0 } else { u_at(total * j as f64 / rings as f64) }).collect();
     let around: Vec<f64> = (0..=64).map(|k| TAU * k as f64 / 64.0).collect();
-    let ring_pts = patch.grid_values(&ring_us, &around);
+    let ring_pts = filled.values(&ring_us, &around);
     for (j, &u) in ring_us.iter().enumerate() {
         let pts = &ring_pts[j * around.len()..(j + 1) * around.len()];
         let perim: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -335,7 +436,7 @@ pub fn fill_loop_with(
             } else {
                 (0..nj).map(|k| TAU * (k as f64 + shift) / nj as f64).collect()
             };
-            let mut pts = patch.grid(&[u], &ring_v);
+            let mut pts = filled.values(&[u], &ring_v);
             let mut ring_v = ring_v;
             if j == 0 && band.is_some() {
                 // a boundary vertex nearer a band vertex than 0.4 h and `SHORTEST` of the
@@ -347,7 +448,7 @@ pub fn fill_loop_with(
                 let mut keep = vec![true; pts.len()];
                 for k in 0..pts.len() {
                     let prev_dropped = k > 1 && !keep[k - 1] && !keep[k - 2];
-                    if !prev_dropped && near(pts[k][0]) && keep.iter().filter(|x| **x).count() > 3 {
+                    if !prev_dropped && near(pts[k]) && keep.iter().filter(|x| **x).count() > 3 {
                         keep[k] = false;
                     }
                 }
@@ -363,7 +464,7 @@ pub fn fill_loop_with(
                 .into_iter()
                 .zip(pts)
                 .map(|(v, p)| {
-                    positions.push(p[0]);
+                    positions.push(p);
                     let y = if j == 0 { y_of_s(line.sigma(w0 + period * v / TAU)) } else { y_of_s(s_top) + u };
                     (v, y, base + positions.len() as u32 - 1)
                 })
@@ -372,7 +473,7 @@ pub fn fill_loop_with(
             zip(&ring_prev, &ring, &at, &mut triangles);
             ring_prev = ring;
         }
-        positions.push(patch.point(1.0, 0.0));
+        positions.push(filled.pole());
         let pole = base + positions.len() as u32 - 1;
         let np = ring_prev.len();
         for i in 0..np {
@@ -444,9 +545,7 @@ pub fn fill_loop_with(
     }
     Ok(LoopFill {
         fit,
-        fill,
-        fullness,
-        height,
+        shape,
         willmore: willmore_energy,
         positions,
         triangles,
@@ -620,37 +719,39 @@ fn zip(a: &[(f64, f64, u32)], b: &[(f64, f64, u32)], pos: &dyn Fn(u32) -> Vec3, 
     }
 }
 
-/// The fill of least Willmore energy `∫ H² dA` among those of fullness `f` (the length
-/// of the cross tangent against the loop's mean radius) and pole height `h` (the factor
-/// on the least-bending pole's offset from the loop's centroid), `make` giving the fill
-/// and its energy for `[f, h]`. From `(1, 1)`, two rounds of coordinate descent: in each
-/// coordinate the energy at `x ± δ`, the vertex of the parabola through the three (when
-/// it opens upwards; within `3δ` and the bounds `f ∈ [0.5, 2]`, `h ∈ [0, 4]`), and the
-/// lowest point kept; `δ = (0.15, 0.4)`, halved for the second round. Returns the fill,
-/// `[f, h]` and its energy.
+/// The member of least Willmore energy `∫ H² dA` among a fill's two-parameter family,
+/// `energy` giving it for `[x₀, x₁]` — the strip fill's fullness and pole height (from
+/// `(1, 1)` within `[0.5, 2] × [0, 4]`, steps `(0.15, 0.4)`), the disc fill's `f` and `μ`
+/// (from `(1, 0)` within `[0.5, 2] × [−3, 3]`, steps `(0.15, 0.5)`; order 4 has no `μ`).
+/// Two rounds of coordinate descent: in each coordinate the energy at `x ± δ`, the vertex
+/// of the parabola through the three (when it opens upwards; within `3δ` and the bounds),
+/// and the lowest point kept; `δ` halved for the second round. Returns the member and its
+/// energy.
 ///
 /// Why this energy: G1 fixes the fill's boundary and tangent planes, so by Gauss–Bonnet
 /// `∫ K dA` is fixed and `∫ (κ₁² + κ₂²) dA = ∫ (4H² − 2K) dA` differs from `4 ∫ H² dA`
 /// by a constant: the fairest fill bends least. A sphere is a critical point of it, and
 /// for a nearly flat surface `z(x, y)` it is `¼ ∫ (Δz)²`, whose minimisers (biharmonic
 /// `z`) include every quadratic — what a hole in a smooth surface should be filled with.
-/// `f` and `h` are what the G1/G2 conditions leave free to the fill's construction.
-fn fairest(energy: impl Fn([f64; 2]) -> f64) -> ([f64; 2], f64) {
-    const BOUNDS: [(f64, f64); 2] = [(0.5, 2.0), (0.0, 4.0)];
-    let mut x = [1.0, 1.0];
+/// The two parameters are what the G1/G2 conditions leave free to the fill's construction.
+fn fairest(search: &Search, energy: impl Fn([f64; 2]) -> f64) -> ([f64; 2], f64) {
+    let mut x = search.start;
     let mut e = energy(x);
     // NaN (a degenerate fill) never wins
     let better = |a: f64, b: f64| a < b || (b.is_nan() && !a.is_nan());
-    let mut delta = [0.15, 0.4];
+    let mut delta = search.delta;
     for _round in 0..2 {
         for k in [1, 0] {
             let d = delta[k];
+            if d == 0.0 {
+                continue;
+            }
             let at = |t: f64| {
                 let mut y = x;
                 y[k] = t;
                 energy(y)
             };
-            let (lo, hi) = BOUNDS[k];
+            let (lo, hi) = search.bounds[k];
             let (xm, xp) = ((x[k] - d).max(lo), (x[k] + d).min(hi));
             let (em, ep) = (at(xm), at(xp));
             let mut candidates = vec![(xm, em), (xp, ep)];
@@ -668,6 +769,14 @@ fn fairest(energy: impl Fn([f64; 2]) -> f64) -> ([f64; 2], f64) {
         delta = delta.map(|d| d / 2.0);
     }
     (x, e)
+}
+
+/// Where [`fairest`] starts, its bounds and its first steps (a zero step leaves that
+/// coordinate alone).
+struct Search {
+    start: [f64; 2],
+    bounds: [(f64, f64); 2],
+    delta: [f64; 2],
 }
 
 /// The abscissa of the vertex of the parabola through `(a, fa)`, `(b, fb)`, `(c, fc)`

@@ -13,6 +13,7 @@
 mod band;
 mod collar;
 mod crossing;
+mod disc;
 mod fill;
 mod flip;
 mod loops;
@@ -21,7 +22,7 @@ pub mod shapes;
 
 pub use collar::{Collar, CollarError, CollarFit, adjacency, fit_collar};
 pub use crossing::{crossings, crossings_with, triangles_cross};
-pub use fill::{LoopFill, LoopFillError, LoopFillOptions, fill_loop, fill_loop_with};
+pub use fill::{FillShape, LoopFill, LoopFillError, LoopFillOptions, fill_loop, fill_loop_with};
 pub use loops::{LoopKind, MeshLoop, TopologyError, boundary, dihedral_angles, quantile};
 pub use periodic::PeriodicSpline;
 
