@@ -115,6 +115,9 @@ impl Field for Collar {
 pub struct DomainLine {
     sigma: NurbsCurve,
     period: f64,
+    /// The spline's basis and control values, for [`DomainLine::sigma_and_slope`].
+    basis: PeriodicSpline,
+    ctrl: Vec<f64>,
 }
 
 impl DomainLine {
@@ -122,7 +125,16 @@ impl DomainLine {
     pub fn new(basis: &PeriodicSpline, ctrl: &[f64]) -> Self {
         let pts: Vec<Vec3> = ctrl.iter().map(|&c| Vec3::new(c, 0.0, 0.0)).collect();
         let (a, b) = basis.domain();
-        DomainLine { sigma: basis.curve(&pts), period: b - a }
+        DomainLine { sigma: basis.curve(&pts), period: b - a, basis: basis.clone(), ctrl: ctrl.to_vec() }
+    }
+
+    /// `(σ(τ), σ′(τ))` from the periodic basis at `τ` (the same spline as the field's jet,
+    /// without its general NURBS path: the disc fills ask it at every point they evaluate).
+    pub fn sigma_and_slope(&self, tau: f64) -> (f64, f64) {
+        let (j0, b) = self.basis.basis(tau, 1);
+        let n = self.ctrl.len();
+        let sum = |row: &[f64]| (0..4).fold(0.0, |a, r| a + self.ctrl[(j0 + r) % n] * row[r]);
+        (sum(&b[0]), sum(&b[1]))
     }
 
     /// `σ(τ)`.
@@ -673,6 +685,25 @@ mod tests {
         assert!(loop_parameters(&[0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0], &x, 8.0).is_err());
         // NaN feet are refused, not ordered
         assert!(loop_parameters(&[0.0, f64::NAN, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0], &x, 8.0).is_err());
+    }
+
+    /// The line's `σ`, `σ′` from the periodic basis against its NURBS jet at 50 pseudo-random
+    /// `τ`, wrapped ones included.
+    #[test]
+    fn line_slope_matches_its_jet() {
+        let period = 2.0;
+        let b = PeriodicSpline::new((0..9).map(|j| period * (j as f64 + 0.1 * (j % 3) as f64) / 9.0).collect(), period)
+            .unwrap();
+        let ctrl: Vec<f64> = (0..9).map(|j| (j as f64 * 1.3).sin()).collect();
+        let line = DomainLine::new(&b, &ctrl);
+        for q in 0..50 {
+            let tau = -3.0 + 0.1337 * q as f64;
+            let j = line.jet(&[tau], JetShape::new(&[1]));
+            let (s, ds) = line.sigma_and_slope(tau);
+            // control values of size 1, cubic basis: round-off ~1e-15 (both sum four terms)
+            assert!((s - j.value().x).abs() < 1e-14, "{tau}: {s} {}", j.value().x);
+            assert!((ds - j.derivative([1, 0, 0]).x).abs() < 1e-13, "{tau}: {ds} {}", j.derivative([1, 0, 0]).x);
+        }
     }
 
     /// The collar's jet (the bases evaluated once, `spline_derivatives`) against the same

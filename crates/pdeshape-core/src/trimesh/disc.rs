@@ -58,7 +58,6 @@ pub struct DiscSurface {
     line: DomainLine,
     period: f64,
     w0: f64,
-    order: usize,
     /// The plane's normal, the ellipse's centre, and the plane's axes after the affine map
     /// (`z = (a₁·(x − c), a₂·(x − c))`).
     d: Vec3,
@@ -80,8 +79,10 @@ impl DiscSurface {
     /// The disc fill of the line `(σ̄(w), w)`, `w ∈ [w₀, w₀ + L)`, on `collar`, or `None`
     /// when the loop is not star-shaped about a fitted ellipse (see the module).
     pub fn new(collar: &Collar, line: &DomainLine, period: f64, w0: f64, order: usize) -> Option<Self> {
-        let at = |w: f64| line_point(collar, line, w);
-        let dense: Vec<LinePoint> = (0..DENSE).map(|i| at(w0 + period * i as f64 / DENSE as f64)).collect();
+        let at = |w: f64| line_point(collar, line, w, 2);
+        // the dense pass needs points and tangent planes only
+        let dense: Vec<LinePoint> =
+            (0..DENSE).map(|i| line_point(collar, line, w0 + period * i as f64 / DENSE as f64, 1)).collect();
         let mut d = Vec3::ZERO;
         for q in &dense {
             d += q.cw.cross(q.cs).normalized()?;
@@ -138,7 +139,7 @@ impl DiscSurface {
         };
         // θ along the line, unwrapped: it must turn once, monotonically
         let mut th: Vec<f64> = Vec::with_capacity(DENSE + 1);
-        for q in dense.iter().chain(std::iter::once(&at(w0 + period))) {
+        for q in dense.iter().chain(std::iter::once(&line_point(collar, line, w0 + period, 1))) {
             let t = angle(q.p);
             let t = match th.last() {
                 Some(&prev) => prev + (t - prev + std::f64::consts::PI).rem_euclid(TAU) - std::f64::consts::PI,
@@ -162,7 +163,6 @@ impl DiscSurface {
             line: line.clone(),
             period,
             w0,
-            order,
             d,
             c,
             a,
@@ -181,7 +181,7 @@ impl DiscSurface {
             let (mut lo, mut hi) = (period * (i - 1) as f64 / DENSE as f64, period * i as f64 / DENSE as f64);
             let mut x = 0.5 * (lo + hi);
             for _ in 0..60 {
-                let q = at(w0 + x);
+                let q = line_point(collar, line, w0 + x, 1);
                 let f = me.theta_of(q.p, target) - target;
                 if f.abs() < 1e-15 {
                     break;
@@ -296,7 +296,7 @@ impl DiscSurface {
 
     /// The exact data `[X, X_r, X_rr]` of the chosen member at `w`, and `θ(w)`.
     fn data_at(&self, w: f64) -> ([Vec3; 3], f64) {
-        let q = line_point(&self.collar, &self.line, w);
+        let q = line_point(&self.collar, &self.line, w, 2);
         let (f, mu) = self.chosen;
         let (x, g, qq) = self.basis_data(&q).unwrap_or((q.p, Vec3::ZERO, Vec3::ZERO));
         let t = self.theta_of(q.p, std::f64::consts::PI);
@@ -306,8 +306,17 @@ impl DiscSurface {
     /// The fill at the strip chart's `(u, v)`: `r = 1 − u`, `w = w₀ + L v/2π`, on the grid
     /// `us × vs` (point `(i, j)` at `i · vs.len() + j`), the remainder included.
     pub fn values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
-        let (data, thetas): (Vec<[Vec3; 3]>, Vec<f64>) =
-            vs.iter().map(|&v| self.data_at(self.w0 + self.period * v / TAU)).unzip();
+        // the data enter only through the remainder, on r > ½
+        let (data, thetas): (Vec<[Vec3; 3]>, Vec<f64>) = if us.iter().any(|&u| 1.0 - u > 0.5) {
+            vs.iter().map(|&v| self.data_at(self.w0 + self.period * v / TAU)).unzip()
+        } else {
+            vs.iter()
+                .map(|&v| {
+                    let q = line_point(&self.collar, &self.line, self.w0 + self.period * v / TAU, 0);
+                    ([Vec3::ZERO; 3], self.theta_of(q.p, std::f64::consts::PI))
+                })
+                .unzip()
+        };
         let rs: Vec<f64> = us.iter().map(|u| 1.0 - u).collect();
         self.fill.grid(&rs, &thetas, &data).into_iter().map(|p| p[0]).collect()
     }
@@ -329,19 +338,20 @@ impl DiscSurface {
 
     /// The fill against the collar along the boundary line at `n` points of `w`: the gap
     /// `|X(1, θ(w)) − γ(w)|`, the angle between the normals `γ′ × X_r` and the collar's, and
-    /// (order 6) the difference of the normal curvatures, `(X_rr·n − II(X_r, X_r))/(X_r·e)²`
+    /// the difference of the normal curvatures (small at order 6; at order 4, how far from
+    /// G2 the fill is), `(X_rr·n − II(X_r, X_r))/(X_r·e)²`
     /// with `e` the unit tangent across `γ′` — the only entry of the two second fundamental
     /// forms that G1 along the line leaves free (see the module) — times the loop's mean
     /// radius. `X`, `X_r`, `X_rr` are the fill's own (modal part and remainder); along `r = 1`
     /// the fill is the line (the gap says how nearly), so its tangent there is `γ′`.
     pub fn continuity(&self, n: usize) -> EdgeContinuity {
         let (mut g1, mut gap, mut g2) = (0.0f64, 0.0f64, 0.0f64);
-        let k = self.order / 2;
-        for i in 0..n {
-            let w = self.w0 + self.period * (i as f64 + 0.5) / n as f64;
-            let q = line_point(&self.collar, &self.line, w);
-            let (data, t) = self.data_at(w);
-            let x = self.fill.point(1.0, t, &data[..k]);
+        let ws: Vec<f64> = (0..n).map(|i| self.w0 + self.period * (i as f64 + 0.5) / n as f64).collect();
+        let (data, thetas): (Vec<[Vec3; 3]>, Vec<f64>) = ws.iter().map(|&w| self.data_at(w)).unzip();
+        // the fill at r = 1 at every sample in one grid evaluation
+        let fill = self.fill.grid(&[1.0], &thetas, &data);
+        for (&w, x) in ws.iter().zip(&fill) {
+            let q = line_point(&self.collar, &self.line, w, 2);
             gap = max_nan(gap, (x[0] - q.p).norm() / self.radius);
             let nc = q.cw.cross(q.cs);
             let nf = q.dp.cross(x[1]);
@@ -364,12 +374,12 @@ impl DiscSurface {
     }
 }
 
-/// The collar's geometry at the line's point `w`.
-fn line_point(collar: &Collar, line: &DomainLine, w: f64) -> LinePoint {
-    let sj = line.jet(&[w], JetShape::new(&[1]));
-    let (s, ds) = (sj.value().x, sj.derivative([1, 0, 0]).x);
-    let j = collar.jet(&[s, w], JetShape::new(&[2, 2]));
-    let dv = |i: usize, k: usize| j.derivative([i, k, 0]);
+/// The collar's geometry at the line's point `w`, its derivatives up to order `nd` (1 or 2;
+/// the second ones are zero for 1).
+fn line_point(collar: &Collar, line: &DomainLine, w: f64, nd: usize) -> LinePoint {
+    let (s, ds) = line.sigma_and_slope(w);
+    let j = collar.jet(&[s, w], JetShape::new(&[nd, nd]));
+    let dv = |i: usize, k: usize| if i.max(k) <= nd { j.derivative([i, k, 0]) } else { Vec3::ZERO };
     let (cs, cw) = (dv(1, 0), dv(0, 1));
     LinePoint { p: j.value(), dp: cs * ds + cw, cs, cw, css: dv(2, 0), csw: dv(1, 1), cww: dv(0, 2) }
 }
