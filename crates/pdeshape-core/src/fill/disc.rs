@@ -174,22 +174,7 @@ impl DiscFill {
     /// The modal part `F` and its derivatives at `(r, θ)`: `[F, F_r, F_θ, F_rr, F_rθ,
     /// F_θθ]`, exactly (no remainder).
     pub fn modal(&self, r: f64, theta: f64) -> [Vec3; 6] {
-        let mut out = [Vec3::ZERO; 6];
-        let (s1, c1) = theta.sin_cos();
-        let (mut s, mut c) = (0.0, 1.0);
-        for (n, m) in self.modes.iter().enumerate() {
-            let nf = n as f64;
-            let (rc, rs) = (radial_vec(n, [m[0], m[1], m[2]], r), radial_vec(n, [m[3], m[4], m[5]], r));
-            // X = A cos + B sin; X_θ = n(−A sin + B cos); X_θθ = −n² X
-            out[0] += rc[0] * c + rs[0] * s;
-            out[1] += rc[1] * c + rs[1] * s;
-            out[2] += (rs[0] * c - rc[0] * s) * nf;
-            out[3] += rc[2] * c + rs[2] * s;
-            out[4] += (rs[1] * c - rc[1] * s) * nf;
-            out[5] += (rc[0] * c + rs[0] * s) * (-nf * nf);
-            (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
-        }
-        out
+        self.modal_grid(&[r], &[theta])[0]
     }
 
     /// The modal part and its derivatives on the grid `rs × thetas` (point `(i, j)` at
@@ -245,14 +230,7 @@ impl DiscFill {
                 let (r, j) = (rs[p / nt], p % nt);
                 let mut out = [f[0], f[1], f[3]];
                 if r > 0.5 {
-                    let modal_data = [at_one[j][0], at_one[j][1], at_one[j][3]];
-                    let phi = profiles(r);
-                    for i in 0..self.k {
-                        let e = data[j][i] - modal_data[i];
-                        for (d, o) in out.iter_mut().enumerate() {
-                            *o += e * phi[i][d];
-                        }
-                    }
+                    self.add_remainder(&mut out, r, &at_one[j], &data[j]);
                 }
                 out
             })
@@ -267,17 +245,22 @@ impl DiscFill {
         let f = self.modal(r, theta);
         let mut out = [f[0], f[1], f[3]];
         if r > 0.5 {
-            let at_one = self.modal(1.0, theta);
-            let modal_data = [at_one[0], at_one[1], at_one[3]];
-            let phi = profiles(r);
-            for i in 0..self.k {
-                let e = data[i] - modal_data[i];
-                for (d, o) in out.iter_mut().enumerate() {
-                    *o += e * phi[i][d];
-                }
-            }
+            self.add_remainder(&mut out, r, &self.modal(1.0, theta), data);
         }
         out
+    }
+
+    /// Adds the remainder at radius `r` to `out` (`[X, X_r, X_rr]`): `at_one` the modal part
+    /// at `r = 1` and the same `θ`, `data` the exact `∂ⁱ_r X(1, θ)`.
+    fn add_remainder(&self, out: &mut [Vec3; 3], r: f64, at_one: &[Vec3; 6], data: &[Vec3]) {
+        let modal_data = [at_one[0], at_one[1], at_one[3]];
+        let phi = profiles(r);
+        for i in 0..self.k {
+            let e = data[i] - modal_data[i];
+            for (d, o) in out.iter_mut().enumerate() {
+                *o += e * phi[i][d];
+            }
+        }
     }
 
     /// The centre `X(0, ·)`.

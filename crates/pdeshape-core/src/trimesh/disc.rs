@@ -52,6 +52,23 @@ struct LinePoint {
     cww: Vec3,
 }
 
+impl LinePoint {
+    /// `II(v, v)` of the collar against the unit normal `n`, the tangent vector `v`
+    /// written as `α C_s + β C_w` by the normal equations of the tangent basis.
+    fn second_form(&self, v: Vec3, n: Vec3) -> f64 {
+        let (e, f, g) = (self.cs.dot(self.cs), self.cs.dot(self.cw), self.cw.dot(self.cw));
+        let det = e * g - f * f;
+        let (bs, bw) = (v.dot(self.cs), v.dot(self.cw));
+        let (al, be) = ((g * bs - f * bw) / det, (e * bw - f * bs) / det);
+        al * al * self.css.dot(n) + 2.0 * al * be * self.csw.dot(n) + be * be * self.cww.dot(n)
+    }
+}
+
+/// The weights of the parts `F₀ … F₃` in the member `(f, μ)`.
+fn weights(f: f64, mu: f64) -> [f64; 4] {
+    [1.0, f, f * f, mu * f]
+}
+
 /// A mesh hole's disc fill: the solved fills, the map `w ↦ θ` and what the data need.
 pub struct DiscSurface {
     collar: Collar,
@@ -250,19 +267,14 @@ impl DiscSurface {
         let proj = rel - self.d * rel.dot(self.d);
         let nd = n.dot(self.d);
         let g = proj - self.d * (proj.dot(n) / nd);
-        // G = α C_s + β C_w (G lies in their span)
-        let (e, f, gg) = (q.cs.dot(q.cs), q.cs.dot(q.cw), q.cw.dot(q.cw));
-        let det = e * gg - f * f;
-        let (bs, bw) = (g.dot(q.cs), g.dot(q.cw));
-        let (al, be) = ((gg * bs - f * bw) / det, (e * bw - f * bs) / det);
-        let ii = al * al * q.css.dot(n) + 2.0 * al * be * q.csw.dot(n) + be * be * q.cww.dot(n);
+        let ii = q.second_form(g, n);
         let out = (q.p, g, self.d * (ii / nd));
         (out.0.is_finite() && out.1.is_finite() && out.2.is_finite()).then_some(out)
     }
 
     /// The fill of data `(γ, f G, f² Q + μ f G)`.
     fn combined(&self, f: f64, mu: f64) -> DiscFill {
-        let w = [1.0, f, f * f, mu * f];
+        let w = weights(f, mu);
         let parts: Vec<(f64, &DiscFill)> = self.parts.iter().enumerate().map(|(p, d)| (w[p], d)).collect();
         DiscFill::combine(&parts)
     }
@@ -274,7 +286,7 @@ impl DiscSurface {
 
     /// The grid of the member `(f, μ)` from the parts' grids.
     pub fn member_grid(grids: &[Vec<[Vec3; 6]>], f: f64, mu: f64) -> Vec<[Vec3; 6]> {
-        let w = [1.0, f, f * f, mu * f];
+        let w = weights(f, mu);
         (0..grids[0].len())
             .map(|i| {
                 let mut o = [Vec3::ZERO; 6];
@@ -360,11 +372,7 @@ impl DiscSurface {
             let ang = nf.cross(nc).norm().atan2(nf.dot(nc).abs());
             g1 = max_nan(g1, ang);
             let nu = nc.normalized().unwrap_or(Vec3::new(f64::NAN, f64::NAN, f64::NAN));
-            let (e, f, gg) = (q.cs.dot(q.cs), q.cs.dot(q.cw), q.cw.dot(q.cw));
-            let det = e * gg - f * f;
-            let (bs, bw) = (x[1].dot(q.cs), x[1].dot(q.cw));
-            let (al, be) = ((gg * bs - f * bw) / det, (e * bw - f * bs) / det);
-            let ii = al * al * q.css.dot(nu) + 2.0 * al * be * q.csw.dot(nu) + be * be * q.cww.dot(nu);
+            let ii = q.second_form(x[1], nu);
             let tu = q.dp.normalized().unwrap_or(Vec3::ZERO);
             let across = nu.cross(tu);
             let xe = x[1].dot(across);
