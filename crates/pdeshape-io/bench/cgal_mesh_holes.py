@@ -15,6 +15,9 @@ included); medians of 3.
     python crates/pdeshape-io/bench/cgal_mesh_holes.py    # needs `pip install cgal numpy`
                                                             # and a release build
 
+With `--noise SIGMA` every vertex of the holed meshes is first moved by normal deviates of
+size SIGMA (seed 1), as a scan's noise; distances are still to the true surfaces.
+
 With `--pictures DIR` the holed meshes and both fills are also written to DIR as OBJ and
 drawn in zebra stripes by `pdeshape render`, and (with `pip install pillow`) put side by
 side in DIR/mesh-holes.png: one row per mesh, the holed mesh, CGAL's fill and pdeshape's.
@@ -274,6 +277,13 @@ def main():
     if not EXE.exists():
         sys.exit(f"build {EXE} first: cargo build --release")
     models = bench_models()
+    if "--noise" in sys.argv:
+        # every vertex moved by a normal deviate of the given size in each coordinate (a
+        # scan's noise); distances are still measured to the true surface
+        sigma = float(sys.argv[sys.argv.index("--noise") + 1])
+        rng = np.random.default_rng(1)
+        models = [(f"{name} + noise {sigma:g}", v + rng.normal(0.0, sigma, v.shape), f, dist, me)
+                  for name, v, f, dist, me in models]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, v, f, dist, max_edges in models:

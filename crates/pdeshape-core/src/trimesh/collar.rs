@@ -18,11 +18,21 @@
 //!    below the offset, so it folds the vertices near the spine onto each other (on the
 //!    tests' torus the fit's residual at the loop was 5–23 times larger, and which loop
 //!    vertex came first decided whether the collar folded).
-//! 3. **Surface.** `C(s, w) = P(w) + Σ_{k=0}^{3} s^k D_k(w)`, `D_k` periodic cubic
-//!    splines on five times the spine's breakpoints (fewer where vertices are few), fitted
-//!    by linear least squares to all those vertices (a second-difference penalty of 10⁻⁶
-//!    of the mean diagonal keeps the `D_k` determined where vertices are few). Noise and
-//!    uneven sampling average out; the residual is reported.
+//! 3. **Surface.** `C(s, w) = P(w) + s B(w) + Σ_{k=0}^{4} s^k D_k(w)`, `B = N × P′ /
+//!    |N × P′|` the unit vector across the spine by which `s` was measured (its jet from
+//!    those of `P` and `N`), `D_k` periodic cubic splines on seven times the spine's
+//!    breakpoints (fewer where vertices are few), fitted by linear least squares to what
+//!    `P + s B` leaves of those vertices (a second-difference penalty of 10⁻⁶ of the mean
+//!    diagonal keeps the `D_k` determined where vertices are few); the residual is
+//!    reported. `s B` a term of its own fits a plane to round-off (`D₁` had to follow `B`,
+//!    which is no spline: 1.4e-4 on the tests' plane). A quartic in `s` needs five levels
+//!    of vertices across the loop, the loop's and four rings (the fill's default). Against
+//!    a cubic on three rings whose `D₁` followed `B`, the fills' distances to the bench's
+//!    true surfaces fell from 4.8e-4 to 1.5e-4 (sphere), 2.4e-3 to 1.1e-3 (torus) and
+//!    8.7e-5 to 5.2e-5 (height field); a cubic on four rings was worse than on three, and
+//!    a quintic on four to six rings folded on the torus. **Noise is not averaged out:**
+//!    the `D_k` have about as many unknowns as there are vertices, and vertices moved by
+//!    3e-4 (a hundredth of an edge) move the fills by 1e-2 … 6e-2 (BENCHMARKS.md).
 //! 4. **The loop on it.** The loop's vertices at `(s_i, w_i)`, their `w_i` increasing
 //!    along the loop: where a staircase's notch steps back along the spine, its feet are
 //!    moved forward by the least squares that leaves every step a fifth of its edge
@@ -45,14 +55,25 @@ use crate::num::max_nan;
 use faer::Mat;
 use std::cmp::Ordering;
 
-/// `C(s, w) = P(w) + Σ_{k=0}^{3} s^k D_k(w)`, `L`-periodic in `w` (slots `s, w`;
+/// `C(k, i)`.
+fn binomial(k: usize, i: usize) -> f64 {
+    (1..=i).map(|r| (k + 1 - r) as f64 / r as f64).product()
+}
+
+/// The `D_k` of the collar, `k < BLOCKS`: a quartic in `s` (see the module).
+const BLOCKS: usize = 5;
+
+/// `C(s, w) = P(w) + s B(w) + Σ_{k=0}^{4} s^k D_k(w)`, `L`-periodic in `w` (slots `s, w`;
 /// constant in time).
 #[derive(Clone, Debug)]
 pub struct Collar {
     /// The spine `P`: its basis and control points.
     spine: (PeriodicSpline, Vec<Vec3>),
+    /// `N`, the spline through the loop's triangles' normals, on the spine's basis: with
+    /// `P′` it gives the unit vector across the spine `B = N × P′ / |N × P′|`.
+    normal: Vec<Vec3>,
     /// The `D_k`: their common basis and each one's control points.
-    d: (PeriodicSpline, [Vec<Vec3>; 4]),
+    d: (PeriodicSpline, [Vec<Vec3>; BLOCKS]),
     period: f64,
 }
 
@@ -74,6 +95,24 @@ fn spline_derivatives<const K: usize>(basis: &PeriodicSpline, ctrl: [&[Vec3]; K]
     })
 }
 
+/// The Taylor coefficients in `w`, orders `0 ..= nd`, of `B = N × P′ / |N × P′|` from
+/// those of `P` and `N` (orders `0 ..= nd + 1`): `c = N × P′` and `g = c·c` by Cauchy
+/// products, `h = g^(−1/2)` by the power series recurrence
+/// `h₀ = g₀^(−1/2)`, `hₙ = (1 / (n g₀)) Σ_{k=1}^{n} ((α + 1) k − n) g_k h_{n−k}` with
+/// `α = −½`, and `B = c h`.
+fn across_taylor(p: &[Vec3], n: &[Vec3], nd: usize) -> Vec<Vec3> {
+    let dp: Vec<Vec3> = (0..=nd).map(|j| p[j + 1] * (j + 1) as f64).collect();
+    let c: Vec<Vec3> = (0..=nd).map(|t| (0..=t).fold(Vec3::ZERO, |a, k| a + n[k].cross(dp[t - k]))).collect();
+    let g: Vec<f64> = (0..=nd).map(|t| (0..=t).map(|k| c[k].dot(c[t - k])).sum()).collect();
+    let mut h = vec![0.0; nd + 1];
+    h[0] = 1.0 / g[0].sqrt();
+    for m in 1..=nd {
+        let sum: f64 = (1..=m).map(|k| (0.5 * k as f64 - m as f64) * g[k] * h[m - k]).sum();
+        h[m] = sum / (m as f64 * g[0]);
+    }
+    (0..=nd).map(|t| (0..=t).fold(Vec3::ZERO, |a, k| a + c[k] * h[t - k])).collect()
+}
+
 impl Field for Collar {
     fn arity(&self) -> usize {
         2
@@ -82,20 +121,22 @@ impl Field for Collar {
     fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
         let [os, ow, _] = shape.orders();
         let (s, w) = (at[0], at.get(1).copied().unwrap_or(0.0).rem_euclid(self.period));
-        let [p] = spline_derivatives(&self.spine.0, [&self.spine.1], w, ow);
+        let [p, nrm] = spline_derivatives(&self.spine.0, [&self.spine.1, &self.normal], w, ow + 1);
+        let across = across_taylor(&p, &nrm, ow);
         let dk = spline_derivatives(&self.d.0, self.d.1.each_ref().map(|c| c.as_slice()), w, ow);
-        let binom = |k: usize, i: usize| -> f64 { (1..=i).map(|r| (k + 1 - r) as f64 / r as f64).product() };
         // `∂ˢⁱ sᵏ = C(k, i) sᵏ⁻ⁱ`, once for the three components
-        let f: [[f64; 4]; 4] = std::array::from_fn(|i| {
-            std::array::from_fn(|k| if k >= i { binom(k, i) * s.powi((k - i) as i32) } else { 0.0 })
+        let f: [[f64; BLOCKS]; BLOCKS] = std::array::from_fn(|i| {
+            std::array::from_fn(|k| if k >= i { binomial(k, i) * s.powi((k - i) as i32) } else { 0.0 })
         });
         VecJet(std::array::from_fn(|q| {
             let mut c = vec![0.0; shape.len()];
-            for i in 0..=os.min(3) {
+            for i in 0..=os.min(BLOCKS - 1) {
                 for j in 0..=ow {
-                    let mut v: f64 = (i..=3).map(|k| f[i][k] * dk[k][j][q]).sum();
+                    let mut v: f64 = (i..BLOCKS).map(|k| f[i][k] * dk[k][j][q]).sum();
                     if i == 0 {
-                        v += p[j][q];
+                        v += p[j][q] + s * across[j][q];
+                    } else if i == 1 {
+                        v += across[j][q];
                     }
                     c[shape.index([i, j, 0])] = v;
                 }
@@ -349,19 +390,24 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
         }
         front = next;
     }
-    // the D_k's breakpoints: five a spine's span where the vertices outnumber the
-    // unknowns (4 a breakpoint), at least three. `D₁` is the unit normal across the spine
-    // `N × P′`, not a spline on its breakpoints: with three a span the fill's distance to
-    // a torus swung 1.8e-3 … 1.0e-2 with the loop's first vertex, with five 1.7e-3 … 2.7e-3
-    let needed = 4 * 3 * spine_controls;
+    // the D_k's breakpoints: seven a spine's span where the vertices outnumber the
+    // unknowns (5 a breakpoint), at least three. `D₁` has to follow the unit normal across
+    // the spine `N × P′`, which is not a spline on its breakpoints: with three a span the
+    // fill's distance to a torus swung 1.8e-3 … 1.0e-2 with the loop's first vertex, with
+    // five 1.7e-3 … 2.7e-3 (a cubic in `s`); with the quartic, over all 54 starts of
+    // `collar_does_not_depend_on_the_loops_first_vertex`, 0.84e-3 … 3.7e-3 with six,
+    // 1.01e-3 … 2.18e-3 with seven, and the height field's distance 4.5e-5 with six,
+    // 5.7e-5 with seven and 1.2e-4 with eight
+    let needed = BLOCKS * 3 * spine_controls;
     if pts.len() < needed {
         return Err(CollarError::TooFewPoints { points: pts.len(), rings, needed });
     }
-    let controls = (5 * spine_controls).min(pts.len() / 4);
+    let controls = (7 * spine_controls).min(pts.len() / BLOCKS);
     let ub = uniform(controls);
     // 2. parameters: feet on the spine and signed distances
     let on_loop = triangles_on_loop(m, lp);
-    let normal = normal_along(m, &on_loop, &chord, period, &us)?;
+    let normal_ctrl = normal_along(m, &on_loop, &chord, period, &us)?;
+    let normal = us.curve(&normal_ctrl);
     // the spine sampled once, for every vertex's foot
     let samples = SpineSamples::new(&spine, &chord, period);
     let feet: Vec<(f64, f64, Vec3)> = pts
@@ -373,8 +419,10 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
             let (pw, t) = (j.derivative([0, 0, 0]), j.derivative([1, 0, 0]));
             let d = xv - pw;
             let side = normal.eval(&[w]).cross(t);
-            let s = d.dot(side) / side.norm();
-            (w, s, d)
+            let across = side * (1.0 / side.norm());
+            let s = d.dot(across);
+            // the collar's `s B(w)` taken out: the `D_k` fit what is left
+            (w, s, d - across * s)
         })
         .collect();
     let width = feet.iter().fold(0.0, |a: f64, f| max_nan(a, f.1));
@@ -385,16 +433,16 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
     let rows = feet.iter().map(|&(w, s, d)| {
         let (j0, bas) = ub.basis(w, 0);
         let beta = s / width;
-        let cols = (0..4)
+        let cols = (0..BLOCKS)
             .flat_map(|k| (0..4).map(move |t| (k, t)))
             .map(|(k, t)| (k * controls + (j0 + t) % controls, beta.powi(k as i32) * bas[0][t]))
             .collect();
         (cols, d)
     });
-    let (sol, cond) = penalised_fit(4 * controls, 4, rows)?;
-    let d: [Vec<Vec3>; 4] =
+    let (sol, cond) = penalised_fit(BLOCKS * controls, BLOCKS, rows)?;
+    let d: [Vec<Vec3>; BLOCKS] =
         std::array::from_fn(|k| column(&sol, k * controls..(k + 1) * controls, width.powi(-(k as i32))));
-    let collar = Collar { spine: (us.clone(), spine_ctrl), d: (ub, d), period };
+    let collar = Collar { spine: (us.clone(), spine_ctrl), normal: normal_ctrl, d: (ub, d), period };
     let mut sq = 0.0;
     let mut max_residual: f64 = 0.0;
     for (&(v, _), &(w, s, _)) in pts.iter().zip(&feet) {
@@ -506,13 +554,13 @@ fn normal_along(
     chord: &[f64],
     period: f64,
     basis: &PeriodicSpline,
-) -> Result<NurbsCurve, LinalgError> {
+) -> Result<Vec<Vec3>, LinalgError> {
     let n = chord.len();
     let data = (0..n).filter_map(|i| {
         let next = if i + 1 == n { period } else { chord[i + 1] };
         Some((0.5 * (chord[i] + next), m.face_normal(on_loop[i]).normalized()?))
     });
-    Ok(basis.curve(&fit_curve(basis, data)?))
+    fit_curve(basis, data)
 }
 
 /// The control points of the periodic cubic spline on `basis` fitted to `data` (parameter,
@@ -708,7 +756,7 @@ mod tests {
 
     /// The collar's jet (the bases evaluated once, `spline_derivatives`) against the same
     /// splines as `NurbsCurve`s (the B-spline module's own jets): `Σ s^k D_k` expanded by
-    /// hand at 50 pseudo-random `(s, w)`, every Taylor coefficient up to order (3, 5).
+    /// hand at 50 pseudo-random `(s, w)`, every Taylor coefficient up to order (4, 5).
     #[test]
     fn jet_matches_the_nurbs_curves() {
         let period = 2.0;
@@ -725,24 +773,43 @@ mod tests {
         };
         let mut pts = |n: usize| -> Vec<Vec3> { (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect() };
         let spine = pts(6);
-        let d: [Vec<Vec3>; 4] = std::array::from_fn(|_| pts(15));
-        let collar = Collar { spine: (us.clone(), spine.clone()), d: (ub.clone(), d.clone()), period };
+        let d: [Vec<Vec3>; BLOCKS] = std::array::from_fn(|_| pts(15));
+        let normal = pts(6);
+        let collar =
+            Collar { spine: (us.clone(), spine.clone()), normal: normal.clone(), d: (ub.clone(), d.clone()), period };
         let curves: Vec<NurbsCurve> = d.iter().map(|c| ub.curve(c)).chain([us.curve(&spine)]).collect();
-        let shape = JetShape::new(&[3, 5]);
+        let shape = JetShape::new(&[4, 5]);
         for _ in 0..50 {
             let (s, w) = (0.6 * rnd(), 3.0 * rnd());
             let got = collar.jet(&[s, w], shape);
             let cj: Vec<VecJet> = curves.iter().map(|c| c.jet(&[w.rem_euclid(period)], JetShape::new(&[5]))).collect();
-            for i in 0..=3 {
+            // `s B(w)`: `B`'s coefficients from the spine's and the normal's own jets
+            // (`across_taylor` itself is checked by `across_is_the_unit_normal`)
+            let taylor = |c: &NurbsCurve| -> Vec<Vec3> {
+                let v = c.jet(&[w.rem_euclid(period)], JetShape::new(&[6]));
+                (0..=6)
+                    .map(|t| Vec3::new(v.0[0].coeff([t, 0, 0]), v.0[1].coeff([t, 0, 0]), v.0[2].coeff([t, 0, 0])))
+                    .collect()
+            };
+            let b = across_taylor(&taylor(&us.curve(&spine)), &taylor(&us.curve(&normal)), 5);
+            let across = |j: usize, q: usize| b[j][q];
+            for i in 0..=4 {
                 for j in 0..=5 {
                     for q in 0..3 {
                         // d^i/ds^i of s^k over i!: C(k, i) s^(k−i)
-                        let binom =
-                            [[1.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0], [1.0, 2.0, 1.0, 0.0], [1.0, 3.0, 3.0, 1.0]];
+                        let binom = [
+                            [1.0, 0.0, 0.0, 0.0, 0.0],
+                            [1.0, 1.0, 0.0, 0.0, 0.0],
+                            [1.0, 2.0, 1.0, 0.0, 0.0],
+                            [1.0, 3.0, 3.0, 1.0, 0.0],
+                            [1.0, 4.0, 6.0, 4.0, 1.0],
+                        ];
                         let mut want: f64 =
-                            (i..4).map(|k| binom[k][i] * s.powi((k - i) as i32) * cj[k].0[q].coeff([j, 0, 0])).sum();
+                            (i..5).map(|k| binom[k][i] * s.powi((k - i) as i32) * cj[k].0[q].coeff([j, 0, 0])).sum();
                         if i == 0 {
-                            want += cj[4].0[q].coeff([j, 0, 0]);
+                            want += cj[5].0[q].coeff([j, 0, 0]) + s * across(j, q);
+                        } else if i == 1 {
+                            want += across(j, q);
                         }
                         let have = got.0[q].coeff([i, j, 0]);
                         // coefficients of size ≤ 10³ (derivatives over breakpoint gaps of 0.13)
@@ -754,6 +821,46 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// `across_taylor`'s coefficients are those of the unit vector along `N × P′`: as jets,
+    /// `B·B = 1`, `B·N = 0` and `B·P′ = 0` in every coefficient up to order 5 (three
+    /// conditions that leave only `±(N × P′)/|N × P′|`), and `B·(N × P′) > 0`; at 50
+    /// pseudo-random points of random cubic splines.
+    #[test]
+    fn across_is_the_unit_normal() {
+        let period = 2.0;
+        let us = PeriodicSpline::new((0..6).map(|j| period * j as f64 / 6.0).collect(), period).unwrap();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut pts = |n: usize| -> Vec<Vec3> { (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect() };
+        let (spine, normal) = (pts(6), pts(6));
+        let nd = 5;
+        for _ in 0..50 {
+            let w = period * (rnd() + 0.5);
+            let [p, n] = spline_derivatives(&us, [&spine, &normal], w, nd + 1);
+            let b = across_taylor(&p, &n, nd);
+            let dp: Vec<Vec3> = (0..=nd).map(|j| p[j + 1] * (j + 1) as f64).collect();
+            // the Taylor coefficient `t` of the dot product of two vector jets, and the sum of
+            // its terms' sizes: the round-off it can carry
+            let dot = |a: &[Vec3], c: &[Vec3], t: usize| {
+                (0..=t).fold((0.0, 0.0), |(v, m), k| (v + a[k].dot(c[t - k]), m + a[k].norm() * c[t - k].norm()))
+            };
+            for t in 0..=nd {
+                let (bb, m) = dot(&b, &b, t);
+                let unit = (bb - if t == 0 { 1.0 } else { 0.0 }, m);
+                for (what, (v, m)) in [("B·B − 1", unit), ("B·N", dot(&b, &n, t)), ("B·P′", dot(&b, &dp, t))] {
+                    // a few dozen products and the jets' own sums: 1e-14 of the terms
+                    assert!(v.abs() <= 1e-14 * m.max(1.0), "{what} order {t}: {v:e} (terms {m:e})");
+                }
+            }
+            assert!(b[0].dot(n[0].cross(dp[0])) > 0.0);
         }
     }
 }

@@ -60,7 +60,8 @@ use std::sync::Arc;
 pub struct LoopFillOptions {
     /// 4 (G1) or 6 (G2).
     pub order: usize,
-    /// Rings of vertices around the loop that the collar is fitted to.
+    /// Rings of vertices around the loop that the collar is fitted to (4 by default: the
+    /// collar is a quartic across the loop, see [`super::collar`]).
     pub rings: usize,
     /// Most new vertices of one fill (the `vertices` cap: a loop long against its edges
     /// would otherwise ask for a mesh of any size).
@@ -72,7 +73,7 @@ pub struct LoopFillOptions {
 
 impl Default for LoopFillOptions {
     fn default() -> Self {
-        LoopFillOptions { order: 4, rings: 3, max_vertices: 4_000_000, disc: true }
+        LoopFillOptions { order: 4, rings: 4, max_vertices: 4_000_000, disc: true }
     }
 }
 
@@ -213,7 +214,7 @@ fn strip_fill(
     // Willmore rule's grid
     let (us, wu) = crate::solid::gauss_legendre(16);
     let vs: Vec<f64> = (0..48).map(|j| TAU * j as f64 / 48.0).collect();
-    // the collar (periodic cubic splines in `w`, a cubic in `s`) and the boundary line (a
+    // the collar (periodic cubic splines in `w`, a quartic in `s`) and the boundary line (a
     // periodic cubic spline) are C2, so the reparametrised collar has no crease for
     // `crease::creases` to look for (512 jets an edge)
     let options = FillOptions { order: o.order, split_creases: false, ..FillOptions::default() };
