@@ -754,6 +754,16 @@ mod tests {
         }
     }
 
+    /// Pseudo-random numbers in `[−½, ½)` (xorshift64 from `seed`): the tests' fixed draws.
+    fn uniform_in_half(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
     /// The collar's jet (the bases evaluated once, `spline_derivatives`) against the same
     /// splines as `NurbsCurve`s (the B-spline module's own jets): `Σ s^k D_k` expanded by
     /// hand at 50 pseudo-random `(s, w)`, every Taylor coefficient up to order (4, 5).
@@ -764,13 +774,7 @@ mod tests {
             PeriodicSpline::new((0..6).map(|j| period * j as f64 / 6.0).collect(), period).unwrap(),
             PeriodicSpline::new((0..15).map(|j| period * j as f64 / 15.0).collect(), period).unwrap(),
         );
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = uniform_in_half(0x2545_f491_4f6c_dd1d);
         let mut pts = |n: usize| -> Vec<Vec3> { (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect() };
         let spine = pts(6);
         let d: [Vec<Vec3>; BLOCKS] = std::array::from_fn(|_| pts(15));
@@ -832,13 +836,7 @@ mod tests {
     fn across_is_the_unit_normal() {
         let period = 2.0;
         let us = PeriodicSpline::new((0..6).map(|j| period * j as f64 / 6.0).collect(), period).unwrap();
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = uniform_in_half(0x9e37_79b9_7f4a_7c15);
         let mut pts = |n: usize| -> Vec<Vec3> { (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect() };
         let (spine, normal) = (pts(6), pts(6));
         let nd = 5;
