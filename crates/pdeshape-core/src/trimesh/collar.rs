@@ -391,13 +391,12 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
         front = next;
     }
     // the D_k's breakpoints: seven a spine's span where the vertices outnumber the
-    // unknowns (5 a breakpoint), at least three. `D₁` has to follow the unit normal across
-    // the spine `N × P′`, which is not a spline on its breakpoints: with three a span the
-    // fill's distance to a torus swung 1.8e-3 … 1.0e-2 with the loop's first vertex, with
-    // five 1.7e-3 … 2.7e-3 (a cubic in `s`); with the quartic, over all 54 starts of
-    // `collar_does_not_depend_on_the_loops_first_vertex`, 0.84e-3 … 3.7e-3 with six,
-    // 1.01e-3 … 2.18e-3 with seven, and the height field's distance 4.5e-5 with six,
-    // 5.7e-5 with seven and 1.2e-4 with eight
+    // unknowns (5 a breakpoint), at least three. Fewer lose the loop's staircase of
+    // vertices at `s ≈ 0`, and the fill's boundary with them: the bench's torus and height
+    // field 1.1e-3 and 5.2e-5 off with seven, 6.2e-3 and 5.5e-4 with three, 8.8e-3 and
+    // 1.4e-3 with two; over all 54 starts of `collar_does_not_depend_on_the_loops_first_
+    // vertex` 1.05e-3 … 1.62e-3 with seven. So many unknowns also follow a mesh's noise
+    // (see the module)
     let needed = BLOCKS * 3 * spine_controls;
     if pts.len() < needed {
         return Err(CollarError::TooFewPoints { points: pts.len(), rings, needed });
