@@ -37,7 +37,8 @@ from CGAL import CGAL_Polygon_mesh_processing as PMP
 from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
 
 ROOT = Path(__file__).resolve().parents[3]
-EXE = ROOT / "target" / "release" / "pdeshape"
+# another build to compare with: PDESHAPE_EXE=/path/to/pdeshape
+EXE = Path(os.environ.get("PDESHAPE_EXE", ROOT / "target" / "release" / "pdeshape"))
 
 
 def icosphere(level):

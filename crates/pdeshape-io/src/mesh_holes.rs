@@ -99,6 +99,11 @@ pub struct MeshFillReport {
     pub collar_rms: f64,
     /// Largest residual.
     pub collar_max: f64,
+    /// The collar's smoothing weight that cross-validation chose (relative to the data;
+    /// near 10⁻¹² the collar follows every vertex, from about 1 on it averages noise).
+    pub collar_smoothing: f64,
+    /// The collar's effective number of unknowns (`tr H`, at most `collar_points`).
+    pub collar_dof: f64,
     /// The fill against the collar: G1 angle (radians), gap and curvature gap (relative
     /// to the loop's radius), sampled along its boundary.
     pub g1: f64,
@@ -169,6 +174,8 @@ pub fn fill_mesh_holes(
             collar_points: f.fit.points,
             collar_rms: f.fit.rms,
             collar_max: max_nan(f.fit.max_residual, f.fit.loop_residual),
+            collar_smoothing: f.fit.smoothing,
+            collar_dof: f.fit.dof,
             g1: f.continuity.g1,
             gap: f.continuity.gap,
             g2: f.continuity.g2,

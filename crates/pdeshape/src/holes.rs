@@ -234,7 +234,7 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
                 _ => String::new(),
             };
             eprintln!(
-                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; {shape} (Willmore energy {:.4e}); seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
+                "hole {}: order {}, {} new vertices, {} new triangles; collar fit rms {:.3e}, max {:.3e} ({} vertices, smoothing {:.1e}, {:.1} effective unknowns); fill to collar G1 {:.3e} rad, gap {:.3e}{g2}; {shape} (Willmore energy {:.4e}); seam dihedral {:.3e} rad (the mesh's 99th percentile {:.3e}); new edges {:.2}–{:.2} × the local median",
                 f.index,
                 o.order,
                 f.new_vertices,
@@ -242,6 +242,8 @@ fn fill_mesh(path: &Path, out: &Path, o: &FillHolesOptions, limits: &Limits, qui
                 f.collar_rms,
                 f.collar_max,
                 f.collar_points,
+                f.collar_smoothing,
+                f.collar_dof,
                 f.g1,
                 f.gap,
                 f.willmore,

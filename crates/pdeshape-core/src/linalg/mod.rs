@@ -37,7 +37,7 @@ pub enum LinalgError {
 }
 
 mod profile;
-pub use profile::ProfileCholesky;
+pub use profile::{Envelope, ProfileCholesky};
 
 /// The 2-norm condition number `σ_max / σ_min` of a matrix (∞ for a rank-deficient one).
 pub fn condition_number(a: &Mat<f64>) -> Result<f64, LinalgError> {

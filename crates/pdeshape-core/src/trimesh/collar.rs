@@ -21,18 +21,29 @@
 //! 3. **Surface.** `C(s, w) = P(w) + s B(w) + Σ_{k=0}^{4} s^k D_k(w)`, `B = N × P′ /
 //!    |N × P′|` the unit vector across the spine by which `s` was measured (its jet from
 //!    those of `P` and `N`), `D_k` periodic cubic splines on seven times the spine's
-//!    breakpoints (fewer where vertices are few), fitted by linear least squares to what
-//!    `P + s B` leaves of those vertices (a second-difference penalty of 10⁻⁶ of the mean
-//!    diagonal keeps the `D_k` determined where vertices are few); the residual is
-//!    reported. `s B` a term of its own fits a plane to round-off (`D₁` had to follow `B`,
-//!    which is no spline: 1.4e-4 on the tests' plane). A quartic in `s` needs five levels
-//!    of vertices across the loop, the loop's and four rings (the fill's default). Against
-//!    a cubic on three rings whose `D₁` followed `B`, the fills' distances to the bench's
-//!    true surfaces fell from 4.8e-4 to 1.5e-4 (sphere), 2.4e-3 to 1.1e-3 (torus) and
-//!    8.7e-5 to 5.2e-5 (height field); a cubic on four rings was worse than on three, and
-//!    a quintic on four to six rings folded on the torus. **Noise is not averaged out:**
-//!    the `D_k` have about as many unknowns as there are vertices, and vertices moved by
-//!    3e-4 (a hundredth of an edge) move the fills by 1e-2 … 6e-2 (BENCHMARKS.md).
+//!    breakpoints (fewer where vertices are few), fitted by penalised least squares to
+//!    what `P + s B` leaves of those vertices. `s B` a term of its own fits a plane to
+//!    round-off (`D₁` had to follow `B`, which is no spline: 1.4e-4 on the tests' plane).
+//!    A quartic in `s` needs five levels of vertices across the loop, the loop's and four
+//!    rings (the fill's default). Against a cubic on three rings whose `D₁` followed `B`,
+//!    the fills' distances to the bench's true surfaces fell from 4.8e-4 to 1.5e-4
+//!    (sphere), 2.4e-3 to 1.1e-3 (torus) and 8.7e-5 to 5.2e-5 (height field); a cubic on
+//!    four rings was worse than on three, and a quintic on four to six rings folded on
+//!    the torus.
+//!
+//!    **Smoothing.** The `D_k` have about as many unknowns as there are vertices, so
+//!    unpenalised they follow every vertex, and on a scan the noise: vertices moved by
+//!    3e-4 (a hundredth of an edge) moved the fills by 1e-2 … 6e-2. The penalty is the
+//!    third-order thin-plate energy of `Σ s^k D_k`, its weight chosen by generalised
+//!    cross-validation ([`smoothing`](super::smoothing)), with a second-difference
+//!    penalty of 10⁻⁶ of the mean diagonal that keeps the system determined where
+//!    vertices are few. On the bench's noisy meshes the fills now lie 1.8e-3 / 7.8e-3 /
+//!    2.2e-3 off (sphere, torus, height field) instead of 5.9e-2 / 4.3e-2 / 1.8e-2, with
+//!    weights of 0.4 … 160. The price on clean meshes, where cross-validation still
+//!    chooses weights of 5e-3 … 2e-2 on the sphere's and the height field's holes (1e-12 on
+//!    the torus's): 2.4e-4 / 1.1e-3 / 1.35e-4 instead of 1.5e-4 / 1.1e-3 / 5.2e-5
+//!    (BENCHMARKS.md). The residual is reported with the weight and the effective number
+//!    of unknowns.
 //! 4. **The loop on it.** The loop's vertices at `(s_i, w_i)`, their `w_i` increasing
 //!    along the loop: where a staircase's notch steps back along the spine, its feet are
 //!    moved forward by the least squares that leaves every step a fifth of its edge
@@ -46,11 +57,12 @@
 //!
 //! Derivatives are exact: `∂ᵢ_s ∂ʲ_w C` from the splines' jets and the polynomial in `s`.
 
+use super::smoothing::{Smoothed, add_thin_plate, gcv_solve};
 use super::{MeshLoop, PeriodicSpline, TriMesh};
 use crate::Vec3;
 use crate::data::{Field, NurbsCurve, VecJet};
 use crate::jet::{Jet, JetShape};
-use crate::linalg::{LinalgError, ProfileCholesky};
+use crate::linalg::{Envelope, LinalgError, ProfileCholesky};
 use crate::num::max_nan;
 use faer::Mat;
 use std::cmp::Ordering;
@@ -238,6 +250,12 @@ pub struct CollarFit {
     /// The least-squares normal matrix's 1-norm condition number, estimated
     /// ([`ProfileCholesky`]; the 2-norm one is at most this and at least this over its order).
     pub cond: f64,
+    /// The thin-plate penalty's weight that cross-validation chose, relative to the data
+    /// (`λ tr(Ω) / tr(AᵀA)`, [`smoothing`](super::smoothing)).
+    pub smoothing: f64,
+    /// The fit's effective number of unknowns, `tr H` (at most the vertices fitted; near
+    /// it, the collar follows every vertex).
+    pub dof: f64,
 }
 
 /// Why a collar is not fitted.
@@ -293,50 +311,99 @@ pub fn adjacency(m: &TriMesh) -> Vec<Vec<u32>> {
     adj
 }
 
-/// Solves the penalised normal equations `(AᵀA + λ D) X = Aᵀ B` of a periodic spline fit:
-/// `rows` gives each data row's non-zero columns and values and its right-hand side.
-/// Column `k m + j` (block `k`, control point `j` of `m`) is unknown `j · blocks + k`: so
-/// ordered, a row's columns (four neighbouring control points in every block) and the
-/// penalty's (three in one block) lie within a band of `4 · blocks` but for the control
-/// points that wrap round, and the envelope Cholesky ([`ProfileCholesky`]) costs
-/// `O(n · blocks²)` where the dense one and the symmetric eigenvalues cost `O(n³)`. The
-/// condition number returned is the estimated 1-norm one.
-fn penalised_fit(
-    nc: usize,
+/// The normal equations of a periodic spline fit with `blocks` blocks of `m` control
+/// points: `g = AᵀA`, `r = Aᵀy` (a column a coordinate), `‖y‖²`, the rows of `A`, and a
+/// second-difference penalty of 10⁻⁶ of the mean diagonal in every block that keeps the
+/// system determined where data are few. `rows` gives each data row's non-zero columns and
+/// values and its right-hand side. Column `k m + j` (block `k`, control point `j`) is
+/// unknown [`Normal::at`]`= j · blocks + k`: so ordered, a row's columns (four
+/// neighbouring control points in every block) and the penalties' lie within a band of
+/// `4 · blocks` but for the control points that wrap round, and the envelope Cholesky
+/// ([`ProfileCholesky`]) costs `O(n · blocks²)` where the dense one costs `O(n³)`.
+struct Normal {
+    m: usize,
     blocks: usize,
-    rows: impl Iterator<Item = (Vec<(usize, f64)>, Vec3)>,
-) -> Result<(Mat<f64>, f64), LinalgError> {
-    let m = nc / blocks;
-    let at = |c: usize| (c % m) * blocks + c / m;
-    let mut g = Mat::<f64>::zeros(nc, nc);
-    let mut r = Mat::<f64>::zeros(nc, 3);
-    for (cols, d) in rows {
-        for &(ca, va) in &cols {
-            for &(cb, vb) in &cols {
-                g[(at(ca), at(cb))] += va * vb;
+    g: Envelope,
+    r: Mat<f64>,
+    yy: f64,
+    rows: usize,
+    base: Envelope,
+}
+
+impl Normal {
+    fn new(m: usize, blocks: usize, rows: impl Iterator<Item = (Vec<(usize, f64)>, Vec3)>) -> Self {
+        let nc = m * blocks;
+        let at = |c: usize| (c % m) * blocks + c / m;
+        // control point j meets j − 3 … j + 3 (mod m) in every block: row j · blocks + k's
+        // first entry is control j − 3's, or control 0's where j + 3 wraps round
+        let first = (0..nc)
+            .map(|u| {
+                let j = u / blocks;
+                if j + 3 >= m { 0 } else { j.saturating_sub(3) * blocks }
+            })
+            .collect::<Vec<_>>();
+        let mut g = Envelope::zeros(first.clone());
+        let mut r = Mat::<f64>::zeros(nc, 3);
+        let (mut yy, mut count) = (0.0, 0);
+        for (cols, d) in rows {
+            for &(ca, va) in &cols {
+                for &(cb, vb) in &cols {
+                    if at(cb) <= at(ca) {
+                        g.add_lower(at(ca), at(cb), va * vb);
+                    }
+                }
+                for c in 0..3 {
+                    r[(at(ca), c)] += va * d[c];
+                }
             }
-            for c in 0..3 {
-                r[(at(ca), c)] += va * d[c];
-            }
+            yy += d.dot(d);
+            count += 1;
         }
-    }
-    let trace: f64 = (0..nc).map(|i| g[(i, i)]).sum::<f64>() / nc as f64;
-    let lambda = 1e-6 * trace;
-    for k in 0..blocks {
-        for j in 0..m {
-            let idx = [(j + m - 1) % m, j, (j + 1) % m].map(|i| at(k * m + i));
-            let coef = [1.0, -2.0, 1.0];
-            for a in 0..3 {
-                for b in 0..3 {
-                    g[(idx[a], idx[b])] += lambda * coef[a] * coef[b];
+        let lambda = 1e-6 * (0..nc).map(|i| g.get(i, i)).sum::<f64>() / nc as f64;
+        let mut base = Envelope::zeros(first);
+        for k in 0..blocks {
+            for j in 0..m {
+                let idx = [(j + m - 1) % m, j, (j + 1) % m].map(|i| at(k * m + i));
+                let coef = [1.0, -2.0, 1.0];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        if idx[b] <= idx[a] {
+                            base.add_lower(idx[a], idx[b], lambda * coef[a] * coef[b]);
+                        }
+                    }
                 }
             }
         }
+        Normal { m, blocks, g, r, yy, rows: count, base }
     }
-    // `g` is symmetric positive definite where the fit is determined
-    let solver = ProfileCholesky::new(&g, 1e13)?;
-    let x = solver.solve(&r);
-    Ok((Mat::from_fn(nc, 3, |c, k| x[(at(c), k)]), solver.cond()))
+
+    /// The unknown of column `c`.
+    fn at(&self, c: usize) -> usize {
+        (c % self.m) * self.blocks + c / self.m
+    }
+
+    /// The solution by columns, from one in the unknowns' order.
+    fn by_columns(&self, x: &Mat<f64>) -> Mat<f64> {
+        Mat::from_fn(self.m * self.blocks, 3, |c, k| x[(self.at(c), k)])
+    }
+
+    /// Solves `(AᵀA + base) X = Aᵀy`.
+    fn solve(&self) -> Result<Mat<f64>, LinalgError> {
+        let a = self.g.combination(&[(1.0, &self.g), (1.0, &self.base)]);
+        // symmetric positive definite where the fit is determined
+        let x = ProfileCholesky::from_envelope(&a, 1e13)?.solve(&self.r);
+        Ok(self.by_columns(&x))
+    }
+
+    /// Solves with the thin-plate penalty of `R = Σ_k β^k D̃_k(w)` (`D̃_k` on `basis`,
+    /// `β = s / width`) added, its weight chosen by generalised cross-validation
+    /// ([`smoothing`](super::smoothing)).
+    fn solve_smoothed(&self, basis: &PeriodicSpline, width: f64) -> Result<(Mat<f64>, Smoothed), LinalgError> {
+        let mut omega = Envelope::zeros(self.g.first.clone());
+        add_thin_plate(&mut omega, basis, self.blocks, width, 1.0, |c| self.at(c));
+        let fit = gcv_solve(&self.g, &omega, &self.base, &self.r, self.yy, self.rows)?;
+        Ok((self.by_columns(&fit.x), fit))
+    }
 }
 
 fn column(sol: &Mat<f64>, range: std::ops::Range<usize>, scale: f64) -> Vec<Vec3> {
@@ -394,9 +461,9 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
     // unknowns (5 a breakpoint), at least three. Fewer lose the loop's staircase of
     // vertices at `s ≈ 0`, and the fill's boundary with them: the bench's torus and height
     // field 1.1e-3 and 5.2e-5 off with seven, 6.2e-3 and 5.5e-4 with three, 8.8e-3 and
-    // 1.4e-3 with two; over all 54 starts of `collar_does_not_depend_on_the_loops_first_
-    // vertex` 1.05e-3 … 1.62e-3 with seven. So many unknowns also follow a mesh's noise
-    // (see the module)
+    // 1.4e-3 with two (before the smoothing); over all 54 starts of `collar_does_not_
+    // depend_on_the_loops_first_vertex` 1.05e-3 … 1.62e-3 with seven. So many unknowns
+    // would follow a mesh's noise: the smoothing's weight holds them back (see the module)
     let needed = BLOCKS * 3 * spine_controls;
     if pts.len() < needed {
         return Err(CollarError::TooFewPoints { points: pts.len(), rings, needed });
@@ -438,7 +505,7 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
             .collect();
         (cols, d)
     });
-    let (sol, cond) = penalised_fit(BLOCKS * controls, BLOCKS, rows)?;
+    let (sol, smoothed) = Normal::new(controls, BLOCKS, rows).solve_smoothed(&ub, width)?;
     let d: [Vec<Vec3>; BLOCKS] =
         std::array::from_fn(|k| column(&sol, k * controls..(k + 1) * controls, width.powi(-(k as i32))));
     let collar = Collar { spine: (us.clone(), spine_ctrl), normal: normal_ctrl, d: (ub, d), period };
@@ -467,7 +534,9 @@ pub fn fit_collar(m: &TriMesh, adj: &[Vec<u32>], lp: &MeshLoop, rings: usize) ->
         rms: (sq / feet.len() as f64).sqrt(),
         max_residual,
         loop_residual,
-        cond,
+        cond: smoothed.cond,
+        smoothing: smoothed.weight,
+        dof: smoothed.dof,
     })
 }
 
@@ -563,14 +632,14 @@ fn normal_along(
 }
 
 /// The control points of the periodic cubic spline on `basis` fitted to `data` (parameter,
-/// point) by penalised least squares ([`penalised_fit`]).
+/// point) by penalised least squares ([`Normal`]).
 fn fit_curve(basis: &PeriodicSpline, data: impl Iterator<Item = (f64, Vec3)>) -> Result<Vec<Vec3>, LinalgError> {
     let c = basis.len();
     let rows = data.map(|(t, p)| {
         let (j0, b) = basis.basis(t, 0);
         ((0..4).map(|r| ((j0 + r) % c, b[0][r])).collect(), p)
     });
-    let (sol, _) = penalised_fit(c, 1, rows)?;
+    let sol = Normal::new(c, 1, rows).solve()?;
     Ok(column(&sol, 0..c, 1.0))
 }
 

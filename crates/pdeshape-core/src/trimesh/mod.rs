@@ -19,6 +19,7 @@ mod flip;
 mod loops;
 mod periodic;
 pub mod shapes;
+mod smoothing;
 
 pub use collar::{Collar, CollarError, CollarFit, adjacency, fit_collar};
 pub use crossing::{crossings, crossings_with, triangles_cross};
@@ -54,3 +55,23 @@ fn position(m: &TriMesh, new: &[Vec3], base: u32, i: u32) -> Vec3 {
 
 #[cfg(test)]
 mod tests;
+
+/// The tests' fixed draws: xorshift64 from a seed.
+#[cfg(test)]
+pub(crate) mod draws {
+    /// Uniform in `(0, 1)`.
+    pub fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            ((seed >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        }
+    }
+
+    /// Standard normal (Box–Muller on [`uniform`]).
+    pub fn normal(seed: u64) -> impl FnMut() -> f64 {
+        let mut u = uniform(seed);
+        move || (-2.0 * u().ln()).sqrt() * (std::f64::consts::TAU * u()).cos()
+    }
+}

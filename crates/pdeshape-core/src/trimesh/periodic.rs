@@ -51,6 +51,11 @@ impl PeriodicSpline {
         false
     }
 
+    /// The breakpoints `t₀ < … < t_{n−1}`.
+    pub fn breaks(&self) -> &[f64] {
+        &self.breaks
+    }
+
     /// The parameter range `[t₀, t₀ + L]`.
     pub fn domain(&self) -> (f64, f64) {
         (self.breaks[0], self.breaks[0] + self.period)
