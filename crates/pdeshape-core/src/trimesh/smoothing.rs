@@ -38,7 +38,7 @@
 
 use super::PeriodicSpline;
 use crate::linalg::{Envelope, LinalgError, ProfileCholesky};
-use crate::num::max_nan;
+use crate::num::{max_nan, min_nan};
 use faer::Mat;
 
 /// `k!/(k − a)!`, zero for `k < a`.
@@ -150,11 +150,14 @@ pub(super) fn gcv_solve(
             let gx = g.mul(&col);
             rss += (0..n).map(|i| col[i] * (gx[i] - 2.0 * r[(i, c)])).sum::<f64>();
         }
-        // round-off leaves a tiny negative remainder when the fit interpolates
-        let rss = rss.max(0.0);
+        // round-off leaves a tiny negative remainder when the fit interpolates (a NaN stays)
+        let rss = if rss < 0.0 { 0.0 } else { rss };
         let dof = f.trace_of_inverse_times(g);
         let free = rows as f64 - dof;
         let v = if free > 0.0 { rss * rhs * rows as f64 / (rhs * free).powi(2) } else { f64::INFINITY };
+        if v.is_nan() {
+            return Err(LinalgError::NonFinite);
+        }
         Ok((v, Smoothed { x, weight, dof, cond: f64::NAN }))
     };
     let mut best: Option<(f64, f64, Smoothed)> = None;
@@ -166,7 +169,7 @@ pub(super) fn gcv_solve(
     }
     let (mut bv, be, mut bs) = best.expect("decades tried");
     // golden sections on [be − 3, be + 3] ∩ the grid
-    let (mut lo, mut hi) = (max_nan(be - 3.0, DECADES[0]), (be + 3.0).min(DECADES[DECADES.len() - 1]));
+    let (mut lo, mut hi) = (max_nan(be - 3.0, DECADES[0]), min_nan(be + 3.0, DECADES[DECADES.len() - 1]));
     let phi = (5f64.sqrt() - 1.0) / 2.0;
     let mut a = hi - phi * (hi - lo);
     let mut b = lo + phi * (hi - lo);
@@ -212,8 +215,9 @@ mod tests {
     /// `(cos, sin, sin 3·)` of `2π t` at 300 uneven `t`, each coordinate moved by normal
     /// deviates of 0.05, fitted on 60 control points: the weight chosen scores within 2 %
     /// of the best on a grid of twentieth decades (the golden sections stop at a fifth of
-    /// a decade, where the score is flat), its `tr H` and condition number are the dense
-    /// ones, and the curve lies nearer the noiseless one than the data do.
+    /// a decade, where the score is flat), its `tr H` and solution are the dense ones, its
+    /// condition number is finite, and the curve lies nearer the noiseless one than the
+    /// data do.
     #[test]
     fn gcv_matches_the_dense_score() {
         let (len, n) = (60, 300);
