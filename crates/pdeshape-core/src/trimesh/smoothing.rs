@@ -293,6 +293,36 @@ mod tests {
         assert!(rms < 0.5 * 0.05, "rms {rms:e} to the truth");
     }
 
+    /// A residual that is not a number (data with a NaN) is an error, not a score of zero
+    /// (`f64::max` turned it into one, and the NaN fit came back as the chosen one).
+    #[test]
+    fn nan_data_are_refused() {
+        let len = 12;
+        let basis = PeriodicSpline::new((0..len).map(|j| j as f64 / len as f64).collect(), 1.0).unwrap();
+        let mut g = Envelope::zeros(vec![0; len]);
+        let mut r = Mat::<f64>::zeros(len, 3);
+        for i in 0..40 {
+            let (j0, b) = basis.basis(i as f64 / 40.0, 0);
+            for t in 0..4 {
+                for u in 0..4 {
+                    let (p, q) = ((j0 + t) % len, (j0 + u) % len);
+                    if q <= p {
+                        g.add_lower(p, q, b[0][t] * b[0][u]);
+                    }
+                }
+                r[((j0 + t) % len, 0)] += b[0][t];
+            }
+        }
+        let mut omega = Envelope::zeros(vec![0; len]);
+        add_thin_plate(&mut omega, &basis, 1, 1.0, 1.0, |c| c);
+        let base = Envelope::zeros(vec![0; len]);
+        // the data (1, 0, 0) at every row: a constant, which the fit meets at any weight
+        let f = gcv_solve(&g, &omega, &base, &r, 40.0, 40).unwrap();
+        let off = (0..len).map(|i| (f.x[(i, 0)] - 1.0).abs() + f.x[(i, 1)].abs()).fold(0.0, max_nan);
+        assert!(off < 1e-12, "{off:e}");
+        assert!(matches!(gcv_solve(&g, &omega, &base, &r, f64::NAN, 40), Err(LinalgError::NonFinite)));
+    }
+
     /// The `w` Gram matrices of uniform cubic B-splines of spacing `h`, against their
     /// closed forms (integrals of products of the pieces, by hand): `∫ B_i B_j = h (2416,
     /// 1191, 120, 1)/5040`, `∫ B_i′ B_j′ = (2/3, −1/8, −1/5, −1/120)/h`, `∫ B_i″ B_j″ = (8/3,
