@@ -143,15 +143,21 @@ impl ProfileCholesky {
 
     /// Factorizes the symmetric matrix stored by its envelope (see [`Self::new`]).
     pub fn from_envelope(a: &Envelope, max_cond: f64) -> Result<Self, LinalgError> {
-        let mut f = Self::factor(a)?;
-        let n = a.len();
+        Self::factor(a)?.with_cond(a, max_cond)
+    }
+
+    /// This factorisation of `a` (from [`Self::factor`]) with `a`'s condition number
+    /// estimated; fails as [`Self::new`] does when it exceeds `max_cond`.
+    pub fn with_cond(mut self, a: &Envelope, max_cond: f64) -> Result<Self, LinalgError> {
         let norm1 = a.norm1();
         // A is symmetric: A⁻ᵀ = A⁻¹
-        f.cond = norm1 * super::inverse_norm1_estimate_by(n, |b| f.solve(b), |b| f.solve(b));
-        if f.cond.is_nan() || f.cond > max_cond {
-            return Err(LinalgError::SingularEstimate { cond: f.cond });
+        let f = &self;
+        let cond = norm1 * super::inverse_norm1_estimate_by(a.len(), |b| f.solve(b), |b| f.solve(b));
+        if cond.is_nan() || cond > max_cond {
+            return Err(LinalgError::SingularEstimate { cond });
         }
-        Ok(f)
+        self.cond = cond;
+        Ok(self)
     }
 
     /// The factorisation alone, its condition number not estimated ([`Self::cond`] is

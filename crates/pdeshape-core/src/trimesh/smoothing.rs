@@ -137,7 +137,8 @@ pub(super) fn gcv_solve(
     let tr = |m: &Envelope| (0..n).map(|i| m.get(i, i)).sum::<f64>();
     let unit = tr(g) / tr(omega);
     let rhs = r.ncols() as f64;
-    let eval = |log_w: f64| -> Result<(f64, Smoothed), LinalgError> {
+    // each weight's score, fit, and factorisation (kept for the one chosen)
+    let eval = |log_w: f64| -> Result<(f64, Smoothed, ProfileCholesky), LinalgError> {
         let weight = 10f64.powf(log_w);
         let m = g.combination(&[(1.0, g), (weight * unit, omega), (1.0, base)]);
         let f = ProfileCholesky::factor(&m)?;
@@ -158,13 +159,13 @@ pub(super) fn gcv_solve(
         if v.is_nan() {
             return Err(LinalgError::NonFinite);
         }
-        Ok((v, Smoothed { x, weight, dof, cond: f64::NAN }))
+        Ok((v, Smoothed { x, weight, dof, cond: f64::NAN }, f))
     };
-    let mut best: Option<(f64, f64, Smoothed)> = None;
+    let mut best: Option<(f64, f64, (Smoothed, ProfileCholesky))> = None;
     for e in DECADES {
-        let (v, s) = eval(e)?;
+        let (v, s, f) = eval(e)?;
         if best.as_ref().is_none_or(|b| v < b.0) {
-            best = Some((v, e, s));
+            best = Some((v, e, (s, f)));
         }
     }
     let (mut bv, be, mut bs) = best.expect("decades tried");
@@ -173,37 +174,38 @@ pub(super) fn gcv_solve(
     let phi = (5f64.sqrt() - 1.0) / 2.0;
     let mut a = hi - phi * (hi - lo);
     let mut b = lo + phi * (hi - lo);
-    let (mut va, sa) = eval(a)?;
-    let (mut vb, sb) = eval(b)?;
-    let keep = |v: f64, s: Smoothed, bv: &mut f64, bs: &mut Smoothed| {
+    let (mut va, sa, fa) = eval(a)?;
+    let (mut vb, sb, fb) = eval(b)?;
+    let keep = |v: f64, s: (Smoothed, ProfileCholesky), bv: &mut f64, bs: &mut (Smoothed, ProfileCholesky)| {
         if v < *bv {
             *bv = v;
             *bs = s;
         }
     };
-    keep(va, sa, &mut bv, &mut bs);
-    keep(vb, sb, &mut bv, &mut bs);
+    keep(va, (sa, fa), &mut bv, &mut bs);
+    keep(vb, (sb, fb), &mut bv, &mut bs);
     for _ in 0..REFINE {
         if va < vb {
             hi = b;
             (b, vb) = (a, va);
             a = hi - phi * (hi - lo);
-            let (v, s) = eval(a)?;
+            let (v, s, f) = eval(a)?;
             va = v;
-            keep(v, s, &mut bv, &mut bs);
+            keep(v, (s, f), &mut bv, &mut bs);
         } else {
             lo = a;
             (a, va) = (b, vb);
             b = lo + phi * (hi - lo);
-            let (v, s) = eval(b)?;
+            let (v, s, f) = eval(b)?;
             vb = v;
-            keep(v, s, &mut bv, &mut bs);
+            keep(v, (s, f), &mut bv, &mut bs);
         }
     }
-    // the condition number of the system chosen, which must be solvable by itself
-    let m = g.combination(&[(1.0, g), (bs.weight * unit, omega), (1.0, base)]);
-    bs.cond = ProfileCholesky::from_envelope(&m, 1e13)?.cond();
-    Ok(bs)
+    // the condition number of the system chosen, from the factorisation the search made
+    let (mut fit, f) = bs;
+    let m = g.combination(&[(1.0, g), (fit.weight * unit, omega), (1.0, base)]);
+    fit.cond = f.with_cond(&m, 1e13)?.cond();
+    Ok(fit)
 }
 
 #[cfg(test)]
