@@ -52,4 +52,17 @@ impl Field for Combination {
     fn is_constant_in(&self, slot: usize) -> bool {
         self.terms.iter().all(|(_, f)| f.is_constant_in(slot))
     }
+
+    /// The largest of the terms' degrees when every term is proved a trigonometric
+    /// polynomial (a finite sum of them is one, of at most that degree) and the weights and
+    /// the constant are finite.
+    fn trig_degree(&self) -> Option<usize> {
+        let c = self.constant;
+        if !(c.x.is_finite() && c.y.is_finite() && c.z.is_finite()) {
+            return None;
+        }
+        self.terms
+            .iter()
+            .try_fold(0, |acc, (w, f)| w.is_finite().then(|| f.trig_degree()).flatten().map(|d| acc.max(d)))
+    }
 }

@@ -127,7 +127,8 @@ pub trait Field: Send + Sync + Debug {
     /// of degree at most `d` in slot 0 that does not depend on its other slots; `None` when
     /// nothing is known. Expression fields are analysed ([`crate::expr::trig_degree`]);
     /// other fields say so themselves (a fill's ring `c + ρ (e₁ cos v + e₂ sin v)` has
-    /// degree 1; a trimline keeps its expression surface's degree in `v`). A spectral patch with `M ≥ d` takes such a datum's Fourier tails as zero.
+    /// degree 1; a trimline keeps its expression surface's degree in `v`; a point has
+    /// degree 0 and a combination its terms' largest). A spectral patch with `M ≥ d` takes such a datum's Fourier tails as zero.
     fn trig_degree(&self) -> Option<usize> {
         let (comps, vars) = self.expressions()?;
         comps.iter().try_fold(0, |acc, e| {
@@ -190,6 +191,12 @@ impl Field for PointField {
     fn is_constant_in(&self, _slot: usize) -> bool {
         true
     }
+
+    /// A finite point is a trigonometric polynomial of degree 0.
+    fn trig_degree(&self) -> Option<usize> {
+        let p = self.point;
+        (p.x.is_finite() && p.y.is_finite() && p.z.is_finite()).then_some(0)
+    }
 }
 
 /// A closure field, convenient in tests and for programmatic data: `f(at, shape)`.
@@ -242,10 +249,61 @@ pub fn curve_derivative(f: &dyn Field, v: f64, t: f64, k: usize) -> Vec3 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::fourier::{FourierSeries, sample_count};
     use super::*;
     use proptest::prelude::*;
+
+    /// Checks a claimed [`Field::trig_degree`] `d` independently: the DFT of `f` at
+    /// `8 (d + 1)` points of slot 0 (enough that nothing aliases) has no coefficient above
+    /// `d` beyond round-off.
+    pub(crate) fn assert_no_modes_above(f: &dyn Field, d: usize, what: &str) {
+        let n = 8 * (d + 1);
+        let g: Vec<Vec3> = (0..n).map(|k| f.eval(&[std::f64::consts::TAU * k as f64 / n as f64, 0.0])).collect();
+        let size = g.iter().fold(0.0, |a: f64, x| crate::num::max_nan(a, x.norm()));
+        for m in d + 1..=n / 2 {
+            let (mut c, mut sn) = (Vec3::ZERO, Vec3::ZERO);
+            for (k, x) in g.iter().enumerate() {
+                let th = std::f64::consts::TAU * (m * k) as f64 / n as f64;
+                c += *x * th.cos();
+                sn += *x * th.sin();
+            }
+            // sums of n terms of the size of the data: round-off of n ulps
+            let tail = crate::num::max_nan(c.norm(), sn.norm()) / n as f64;
+            assert!(tail <= 4.0 * n as f64 * f64::EPSILON * size.max(1.0), "{what}, mode {m}: {tail:e}");
+        }
+    }
+
+    /// A point has degree 0, a combination of proved terms its largest term's degree; a
+    /// term not proved, a non-finite weight, constant or point give `None`.
+    #[test]
+    fn points_and_combinations_prove_their_degree() {
+        let vars = ["v", "t"];
+        let curve = |e: [&str; 3]| -> FieldRef { Arc::new(ExprField::parse(e, &vars, &|_| None).unwrap()) };
+        let point = |p: Vec3| -> FieldRef { Arc::new(PointField { point: p, arity: 2 }) };
+        let circle = curve(["2*cos(v)", "2*sin(v)", "0.5"]);
+        let wave = curve(["0", "0", "cos(2*v + 0.3)"]);
+        let p = point(Vec3::new(0.0, 0.0, 1.5));
+        assert_eq!(p.trig_degree(), Some(0));
+        assert_eq!(point(Vec3::new(f64::NAN, 0.0, 0.0)).trig_degree(), None);
+        let c = Combination::new(
+            vec![(0.7, circle.clone()), (-1.2, wave.clone()), (3.0, p.clone())],
+            Vec3::new(1.0, 0.0, 0.0),
+        );
+        assert_eq!(c.trig_degree(), Some(2));
+        assert_no_modes_above(&c, 2, "combination");
+        let c1 = Combination::new(vec![(0.7, circle.clone()), (1.0, p.clone())], Vec3::ZERO);
+        assert_eq!(c1.trig_degree(), Some(1));
+        assert_no_modes_above(&c1, 1, "combination of degree 1");
+        for bad in [
+            Combination::new(vec![(0.7, circle.clone()), (1.0, curve(["v", "0", "0"]))], Vec3::ZERO),
+            Combination::new(vec![(0.7, circle.clone()), (1.0, curve(["t*cos(v)", "0", "0"]))], Vec3::ZERO),
+            Combination::new(vec![(f64::INFINITY, circle.clone())], Vec3::ZERO),
+            Combination::new(vec![(1.0, circle.clone())], Vec3::new(0.0, f64::NAN, 0.0)),
+        ] {
+            assert_eq!(bad.trig_degree(), None);
+        }
+    }
 
     proptest! {
         /// A finite Fourier series is recovered exactly (to round-off) by the FFT analysis.

@@ -164,24 +164,7 @@ mod tests {
                 let tl = Trimline::new(f.clone(), 0.7, order, -1.3);
                 assert_eq!(tl.trig_degree(), want, "{e:?}, order {order}");
                 let Some(d) = want else { continue };
-                let n = 8 * (d + 1);
-                let g: Vec<Vec3> =
-                    (0..n).map(|k| tl.eval(&[std::f64::consts::TAU * k as f64 / n as f64, 0.0])).collect();
-                let size = g.iter().fold(0.0, |a: f64, x| crate::num::max_nan(a, x.norm()));
-                for m in d + 1..=n / 2 {
-                    let (mut c, mut sn) = (Vec3::ZERO, Vec3::ZERO);
-                    for (k, x) in g.iter().enumerate() {
-                        let th = std::f64::consts::TAU * (m * k) as f64 / n as f64;
-                        c += *x * th.cos();
-                        sn += *x * th.sin();
-                    }
-                    // sums of n terms of the size of the data: round-off of n ulps
-                    let tail = crate::num::max_nan(c.norm(), sn.norm()) / n as f64;
-                    assert!(
-                        tail <= 4.0 * n as f64 * f64::EPSILON * size.max(1.0),
-                        "{e:?}, order {order}, mode {m}: {tail:e}"
-                    );
-                }
+                crate::data::tests::assert_no_modes_above(&tl, d, &format!("{e:?}, order {order}"));
             }
         }
     }
