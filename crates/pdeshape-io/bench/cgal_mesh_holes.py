@@ -206,9 +206,10 @@ def measure(v0, f0, v, f, dist):
     return len(new), d.max(), math.sqrt((d * d).mean()), seam, own, n0
 
 
-def bench_models():
-    """The bench's meshes: (name, vertices, faces, distance to the true surface, --max-edges)."""
-    sph_v, sph_f = icosphere(5)
+def bench_models(scale=1):
+    """The bench's meshes: (name, vertices, faces, distance to the true surface, --max-edges).
+    `scale` 2 or 4: the same holes in meshes of half or a quarter the edge length."""
+    sph_v, sph_f = icosphere(5 + {1: 0, 2: 1, 4: 2}[scale])
     caps = [((0.3, 0.2, 0.9), 35), ((-0.7, 0.6, -0.2), 25), ((0.1, -0.8, -0.5), 18)]
 
     def sphere_keep(c):
@@ -218,7 +219,7 @@ def bench_models():
             k &= (c / np.linalg.norm(c, axis=1)[:, None]) @ d < math.cos(math.radians(a))
         return k
 
-    tor_v, tor_f = torus()
+    tor_v, tor_f = torus(128 * scale, 64 * scale)
 
     def torus_keep(c):
         k = np.ones(len(c), bool)
@@ -226,14 +227,14 @@ def bench_models():
             k &= np.linalg.norm(c - np.array(p), axis=1) > 0.3
         return k
 
-    fld_v, fld_f = field()
+    fld_v, fld_f = field(80 * scale)
     return [
         ("sphere, 3 caps (35°, 25°, 18°)", *cut(sph_v, sph_f, sphere_keep),
          lambda p: np.abs(np.linalg.norm(p, axis=1) - 1.0), None),
         ("torus, 2 holes", *cut(tor_v, tor_f, torus_keep),
          lambda p: np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4), None),
         ("height field, elliptical hole", *cut(fld_v, fld_f, lambda c: (c[:, 0] / 0.45) ** 2 + (c[:, 1] / 0.3) ** 2 >= 1),
-         lambda p: np.abs(p[:, 2] - height(p[:, 0], p[:, 1])), "200"),
+         lambda p: np.abs(p[:, 2] - height(p[:, 0], p[:, 1])), str(200 * scale)),
     ]
 
 

@@ -128,7 +128,8 @@ pub trait Field: Send + Sync + Debug {
     /// nothing is known. Expression fields are analysed ([`crate::expr::trig_degree`]);
     /// other fields say so themselves (a fill's ring `c + ρ (e₁ cos v + e₂ sin v)` has
     /// degree 1; a trimline keeps its expression surface's degree in `v`; a point has
-    /// degree 0 and a combination its terms' largest). A spectral patch with `M ≥ d` takes such a datum's Fourier tails as zero.
+    /// degree 0 and a combination its terms' largest). A spectral patch with `M ≥ d` takes
+    /// such a datum's Fourier tails as zero.
     fn trig_degree(&self) -> Option<usize> {
         let (comps, vars) = self.expressions()?;
         comps.iter().try_fold(0, |acc, e| {
