@@ -440,15 +440,26 @@ def test_a_forked_child_computes_after_its_parent_did():
 
 def test_the_module_pool_takes_rayon_num_threads():
     """Regression: the module's own pool (made for forked children) had one thread per
-    core whatever RAYON_NUM_THREADS said, so one-thread measurements ran on all cores."""
+    core whatever RAYON_NUM_THREADS said, so one-thread measurements ran on all cores.
+
+    A pool's threads exist once it is built but name themselves when they first run, so the
+    count is read until it reaches `n` (it never exceeds the pool's size) or 10 s pass: an
+    evaluation that returns before the last thread ran (the blend's data are proved
+    trigonometric and cost 0.1 µs a point) read 2 of 3."""
     import sys
 
     code = (
-        "import glob, numpy as np, pdeshape\n"
+        "import glob, os, time, numpy as np, pdeshape\n"
         f"p = pdeshape.Scene.load({str(ROOT / 'examples/bloor-wilson-blend.toml')!r}).patches[0]\n"
         "p.evaluate(np.column_stack([np.linspace(0, 1, 10000), np.zeros(10000)]))\n"
-        "names = [open(f).read().strip() for f in glob.glob('/proc/self/task/*/comm')]\n"
-        "print(sum(n.startswith('pdeshape-py-') for n in names))\n"
+        "want, end = int(os.environ['RAYON_NUM_THREADS']), time.monotonic() + 10\n"
+        "while True:\n"
+        "    names = [open(f).read().strip() for f in glob.glob('/proc/self/task/*/comm')]\n"
+        "    count = sum(n.startswith('pdeshape-py-') for n in names)\n"
+        "    if count >= want or time.monotonic() > end:\n"
+        "        break\n"
+        "    time.sleep(0.01)\n"
+        "print(count)\n"
     )
     if not Path("/proc/self/task").is_dir():
         pytest.skip("threads are counted in /proc")
