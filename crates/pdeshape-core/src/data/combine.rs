@@ -57,8 +57,7 @@ impl Field for Combination {
     /// polynomial (a finite sum of them is one, of at most that degree) and the weights and
     /// the constant are finite.
     fn trig_degree(&self) -> Option<usize> {
-        let c = self.constant;
-        if !(c.x.is_finite() && c.y.is_finite() && c.z.is_finite()) {
+        if !self.constant.is_finite() {
             return None;
         }
         self.terms

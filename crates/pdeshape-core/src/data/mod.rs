@@ -132,11 +132,22 @@ pub trait Field: Send + Sync + Debug {
     /// such a datum's Fourier tails as zero.
     fn trig_degree(&self) -> Option<usize> {
         let (comps, vars) = self.expressions()?;
-        comps.iter().try_fold(0, |acc, e| {
-            let free = (1..vars.len()).all(|i| !e.depends_on(i));
-            free.then(|| crate::expr::trig_degree(e, 0)).flatten().map(|d| acc.max(d))
-        })
+        components_trig_degree(comps, 0, 1..vars.len())
     }
+}
+
+/// The largest degree in variable `var` of three component expressions, each proved a
+/// trigonometric polynomial in it ([`crate::expr::trig_degree`]) and free of the
+/// variables `free_of`; `None` if one is not.
+pub(crate) fn components_trig_degree(
+    comps: &[crate::expr::Expr; 3],
+    var: usize,
+    free_of: std::ops::Range<usize>,
+) -> Option<usize> {
+    comps.iter().try_fold(0, |acc, e| {
+        let free = free_of.clone().all(|i| !e.depends_on(i));
+        free.then(|| crate::expr::trig_degree(e, var)).flatten().map(|d| acc.max(d))
+    })
 }
 
 /// [`Field::derivatives_in_many`] as one [`Field::derivatives_in`] call a point: the
@@ -195,8 +206,7 @@ impl Field for PointField {
 
     /// A finite point is a trigonometric polynomial of degree 0.
     fn trig_degree(&self) -> Option<usize> {
-        let p = self.point;
-        (p.x.is_finite() && p.y.is_finite() && p.z.is_finite()).then_some(0)
+        self.point.is_finite().then_some(0)
     }
 }
 
@@ -271,7 +281,8 @@ pub(crate) mod tests {
             }
             // sums of n terms of the size of the data: round-off of n ulps
             let tail = crate::num::max_nan(c.norm(), sn.norm()) / n as f64;
-            assert!(tail <= 4.0 * n as f64 * f64::EPSILON * size.max(1.0), "{what}, mode {m}: {tail:e}");
+            let bound = 4.0 * n as f64 * f64::EPSILON * crate::num::max_nan(size, 1.0);
+            assert!(tail <= bound, "{what}, mode {m}: {tail:e}");
         }
     }
 

@@ -96,10 +96,8 @@ impl Field for Trimline {
     /// `∂ᵈS/∂sᵈ(s₀, v) = Σ a_n⁽ᵈ⁾(s₀) e^{inv}` has degree at most `d` too.
     fn trig_degree(&self) -> Option<usize> {
         let (comps, vars) = self.surface.expressions()?;
-        comps.iter().try_fold(0, |acc, e| {
-            let free = (2..vars.len()).all(|i| !e.depends_on(i));
-            free.then(|| crate::expr::trig_degree(e, 1)).flatten().map(|d| acc.max(d))
-        })
+        // slot 0 (`s`) is fixed at `s₀` and may appear; `t` and later may not
+        super::components_trig_degree(comps, 1, 2..vars.len())
     }
 }
 
