@@ -163,7 +163,7 @@ pub fn fit_scene(sc: &Scene, o: &CadOptions) -> Result<Vec<CadFace>, String> {
         let fo = FitOptions {
             tolerance,
             relative,
-            degree: o.degree,
+            degrees: (o.degree, o.degree),
             v_breaks: j.v_breaks.clone(),
             u_start,
             v_start,

@@ -401,17 +401,19 @@ pub fn fit_filled(
         )));
     }
     let size = m.brep.size();
-    // degree 5 at both orders: against degree 3 at order 4 it needs fewer control points
-    // (cylinder 9 × 31 against 19 × 79), leaves the seam's angle 4–25× smaller and takes
-    // as long or half as long (BENCHMARKS.md, fill-holes)
-    let degree = 5;
+    // degree 9 in both directions, with knots of multiplicity 6 where the corner blends
+    // end (the fill is C³ there): against degree 5 without them, the four OCCT models'
+    // holes need 2–4× fewer control points along the loop and less time, their seams
+    // within the same tolerances (BENCHMARKS.md, "fill-holes: knots where the corner
+    // blends end")
     let fo = FitOptions {
         tolerance: Some(relative * size),
-        degree,
+        degrees: (9, 9),
         v_breaks: fill.corner_parameters(),
+        v_joins: fill.blend_joins(),
         edge: Some(seam_tolerance(order, size)),
-        // the edge's tolerances take up to ~490 points along the loop (a rounded box's
-        // corner at order 6: its corner blends are polynomials of degree 7 in v)
+        // the cap of the control points along the loop (a rounded box's corner at order 6
+        // takes 214)
         max_points: 1000,
         ..Default::default()
     };

@@ -181,6 +181,42 @@ impl LoopData {
         ((1.0 - ws - we) * p.c + ws * p.start.0 + we * p.end.0, ws * p.start.1 + we * p.end.1)
     }
 
+    /// Where the corner blends end, `(v, 3)` each: across these lines the cross derivatives
+    /// are only C³ in `v` (the bump `ω` has three vanishing derivatives at its end, not
+    /// four). A blend that moves nothing is left out: the data are then smooth across its
+    /// end. A blend moves nothing when, at its corner, its change of the cross tangent
+    /// `(a − c) S_s + b S_w + g N` is at most 1e-12 of `|c S_s|` and (order-6 data) the change
+    /// `γ S_s + δ S_w + η N` of the second cross derivative at most 1e-12 of `|c S_s|² κ`,
+    /// `κ` the larger of `|S_ss| / |S_s|²` and `|S_ww| / |S_w|²` (the ends of a single closed smooth edge, whose corner is the same point from both
+    /// sides: there the means equal each side's own data).
+    pub fn blend_joins(&self, t: f64) -> Vec<(f64, usize)> {
+        let n = self.pieces.len();
+        let span = TAU / n as f64;
+        let h = self.blend * span;
+        let mut out = Vec::new();
+        for (k, p) in self.pieces.iter().enumerate() {
+            for (w, (a, b), g, q, at) in [
+                (p.w0, p.start, p.start_n, p.start2, k as f64 * span + h),
+                (p.w0 + p.lambda * span, p.end, p.end_n, p.end2, (k + 1) as f64 * span - h),
+            ] {
+                let f = second_frame(&p.surface, p.s0, w, t);
+                let nn = f[1].cross(f[2]);
+                let first = f[1] * (a - p.c) + f[2] * b + nn * g;
+                let second = f[1] * q[0] + f[2] * q[1] + nn * q[2];
+                let cross = (f[1] * p.c).norm();
+                let kappa = crate::num::max_nan(f[3].norm() / f[1].dot(f[1]), f[5].norm() / f[2].dot(f[2]));
+                // a blend with a non-finite frame or correction counts as moving
+                let moves = |d: Vec3, base: f64| d.norm().is_nan() || base.is_nan() || d.norm() > 1e-12 * base;
+                if moves(first, cross) || moves(second, cross * cross * kappa) {
+                    out.push((at, 3));
+                }
+            }
+        }
+        out.sort_by(|x, y| x.0.total_cmp(&y.0));
+        out.dedup_by(|x, y| x.0 == y.0);
+        out
+    }
+
     /// The neighbour's `[S, S_s, S_w, S_ss, S_sw, S_ww]` at the loop's `v` (for diagnostics).
     pub fn frame2(&self, v: f64, t: f64) -> [Vec3; 6] {
         let (k, dv) = self.locate(v);

@@ -913,6 +913,15 @@ impl Fill {
         (1..n).map(|k| TAU * k as f64 / n as f64).collect()
     }
 
+    /// Where the corner blends end, with the fill's smoothness across them (`(v, 3)`):
+    /// the blends' bump is a polynomial of degree 7 joined to 0 with three vanishing
+    /// derivatives, so the cross derivatives `X_u` (and `X_uu`) are only C³ in `v` there
+    /// (blends that change nothing left out). A B-spline fit puts knots of multiplicity
+    /// `degree − 3` there ([`crate::fit::FitOptions::v_joins`]).
+    pub fn blend_joins(&self) -> Vec<(f64, usize)> {
+        self.position.blend_joins(self.t)
+    }
+
     /// G1 angle, position gap and curvature gap against the neighbours at `per_edge` points
     /// of every edge (its start corner included), NaN-propagating.
     pub fn edge_continuity(&self, per_edge: usize) -> EdgeContinuity {

@@ -432,3 +432,59 @@ fn the_pole_ring_is_a_trigonometric_polynomial() {
     assert_eq!(ring(f64::NAN, Vec3::new(1.0, 0.0, 0.0)).trig_degree(), None);
     assert_eq!(ring(0.5, Vec3::new(f64::INFINITY, 0.0, 0.0)).trig_degree(), None);
 }
+
+/// The corner blends' ends reported by [`Fill::blend_joins`] are where the loop data stop
+/// being smooth: at each, the cross derivatives' Taylor coefficients in `v` up to the third
+/// agree from both sides (to the round-off of a step of 1e-9), and the fourth jumps
+/// (sphere triangle, order 6: six joins). A sphere's latitude circle cut into three edges
+/// (as a CAD model's single closed edge is), whose corners the two sides see alike,
+/// reports none.
+#[test]
+fn blend_joins_are_where_the_fourth_derivative_jumps() {
+    let o = FillOptions { order: 6, ..Default::default() };
+    let fill = Fill::new(&sphere_hole(3, f64::to_radians(50.0)), &o).unwrap();
+    let joins = fill.blend_joins();
+    let span = TAU / 3.0;
+    let h = o.corner_blend * span;
+    let expected: Vec<f64> = (0..3).flat_map(|k| [k as f64 * span + h, (k + 1) as f64 * span - h]).collect();
+    assert_eq!(joins.len(), 6, "{joins:?}");
+    for ((v, k), e) in joins.iter().zip(&expected) {
+        assert_eq!(*k, 3);
+        assert!((v - e).abs() <= 1e-15 * TAU, "{v} against {e}");
+    }
+    // the loop's cross derivatives (not the pole's ring, at u = 1)
+    for c in fill.conditions().iter().filter(|c| c.u == 0.0 && c.order >= 1) {
+        for &(v, _) in &joins {
+            let series = |v: f64| c.data.jet(&[v, 0.0], JetShape::new(&[4, 0]));
+            let (left, right) = (series(v - 1e-9), series(v + 1e-9));
+            let coeff = |j: &VecJet, i: usize, comp: usize| j.0[comp].coeff([i, 0, 0]);
+            let jump = |i: usize| {
+                (0..3).map(|comp| (coeff(&left, i, comp) - coeff(&right, i, comp)).abs()).fold(0.0, crate::num::max_nan)
+            };
+            // a C³ function moves its first four coefficients by O(1e-9 × its fourth)
+            // across the step (measured ≤ 4e-7 against fourths of 1e1–1e2); the fourth
+            // jumps by p⁗(1)/4! h⁻⁴ = 35/h⁴ times the blend's correction
+            let top = jump(4);
+            assert!(top > 1e-3, "order {}, v = {v}: the fourth coefficient does not jump ({top})", c.order);
+            for i in 0..4 {
+                assert!(jump(i) <= 1e-6 * top, "order {}, v = {v}: coefficient {i} jumps by {}", c.order, jump(i));
+            }
+        }
+    }
+    // a latitude circle: S(s, w) = (sin(θ+s) cos w, sin(θ+s) sin w, cos(θ+s)), three edges
+    let f: FieldRef = Arc::new(
+        ExprField::parse(["sin(0.8+s)*cos(w)", "sin(0.8+s)*sin(w)", "cos(0.8+s)"], &["s", "w", "t"], &|_| None)
+            .unwrap(),
+    );
+    let edges: Vec<FillEdge> = (0..3)
+        .map(|k| FillEdge {
+            surface: f.clone(),
+            s0: 0.0,
+            w: (k as f64 * span, (k + 1) as f64 * span),
+            fullness: 1.0,
+            side: None,
+        })
+        .collect();
+    let cap = Fill::new(&edges, &o).unwrap();
+    assert_eq!(cap.blend_joins(), vec![], "a smooth closed loop");
+}

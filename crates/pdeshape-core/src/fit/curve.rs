@@ -47,7 +47,7 @@ pub fn fit_curve(
     interior.sort_by(f64::total_cmp);
     interior.dedup();
     loop {
-        let knots = super::knots_with_breaks(p, t0, t1, &interior, &corners);
+        let knots = super::knots_with_breaks(p, t0, t1, &interior, &corners, &[]);
         let g = knots.greville();
         let rows: Vec<(f64, usize)> = g.iter().map(|&t| (t, 0)).collect();
         let rhs: Vec<Vec<Vec3>> = g.iter().map(|&t| vec![c(t)]).collect();

@@ -90,8 +90,9 @@ fn misses(tol: &EdgeTolerance, s: [Vec3; 6], x: [Vec3; 6]) -> f64 {
 /// Samples per span at which the edge is compared.
 const K: usize = 8;
 
-/// The `v` interior breakpoints (C0 lines `c0` kept, of full multiplicity) from which the
-/// fit of `s` of degree `p` on `[lo, hi]` meets `tol` along its `u = 0` edge: a span that
+/// The `v` interior breakpoints (C0 lines `c0` kept, of full multiplicity, and `Cᵏ` lines
+/// `joins`, of multiplicity `p − k`) from which the fit of `s` of degree `p` on `[lo, hi]`
+/// meets `tol` along its `u = 0` edge: a span that
 /// misses by a factor `m` is cut into `⌈(1.2 m)^(1/p)⌉` equal pieces (at least two; the
 /// edge's angle error falls like `hᵖ` with the span `h`, its gap like `hᵖ⁺¹`), until every
 /// sample meets it or the net would exceed `max_points` in `v` (then the breakpoints
@@ -101,14 +102,14 @@ pub(super) fn edge_breakpoints(
     p: usize,
     (lo, hi): (f64, f64),
     start: Vec<f64>,
-    c0: &[f64],
+    (c0, joins): (&[f64], &[(f64, usize)]),
     tol: &EdgeTolerance,
     max_points: usize,
 ) -> Result<Vec<f64>, FitError> {
     let mut interior = start;
     loop {
         crate::cancel::checkpoint();
-        let kv = knots_with_breaks(p, lo, hi, &interior, c0);
+        let kv = knots_with_breaks(p, lo, hi, &interior, c0, joins);
         let miss = span_misses(s, &kv, tol)?;
         if miss.iter().all(|&m| m <= 1.0) {
             return Ok(interior);
@@ -124,7 +125,7 @@ pub(super) fn edge_breakpoints(
                 next.extend((1..pieces).map(|k| w[0] + (w[1] - w[0]) * k as f64 / pieces as f64));
             }
         }
-        let count = next.len() + c0.len() * (p - 1) + p + 1;
+        let count = super::control_count(p, next.len(), c0, joins);
         if count > max_points {
             return Ok(interior);
         }

@@ -1,9 +1,15 @@
 //! Tensor-product B-spline approximation of exact surfaces to a measured maximum deviation (for CAD exchange).
 //!
 //! A patch `X(u, v)` (any [`Surface`]: exact derivatives) is approximated by a clamped
-//! B-spline surface `S(u, v) = Σᵢⱼ Nᵢ(u) Mⱼ(v) Pᵢⱼ` of degree 3 (or 5) on the patch's own
-//! parameter rectangle `[0, 1] × [v₀, v₁]`:
+//! B-spline surface `S(u, v) = Σᵢⱼ Nᵢ(u) Mⱼ(v) Pᵢⱼ` of degrees `(p, q)` (3 or more) on the
+//! patch's own parameter rectangle `[0, 1] × [v₀, v₁]`:
 //!
+//! - **Knots where the patch is not smooth**: a line where the patch is only C0 (an N-sided
+//!   fill's corners, or a kink the refinement finds) gets a knot of full multiplicity `q`;
+//!   a line where it is only `Cᵏ` (where a fill's corner blends end, `k = 3`) a knot of
+//!   multiplicity `q − k`. The spline space then holds the jump of the patch's
+//!   `(k+1)`-th derivative, and the fit converges across the line at its full rate (a
+//!   simple knot there: at `hᵏ⁺¹`, whatever the degree).
 //! - **Fit**: interpolation at the Greville abscissae, separably — `X` sampled on
 //!   `gᵘ × gᵛ`, then `Bᵤ C = X` per column and `Bᵥ Pᵀ = Cᵀ` per row, `B` the collocation
 //!   matrices (non-singular by Schoenberg–Whitney, well conditioned at Greville points);
@@ -109,8 +115,9 @@ pub struct FitOptions {
     /// The tolerance relative to the patch's bounding-box diagonal when `tolerance` is
     /// `None` (default 1e-6).
     pub relative: f64,
-    /// Degree in both directions (3, or 5 when C2 must survive).
-    pub degree: usize,
+    /// Degrees in `u` and in `v` (3, or 5 and more when C2 must survive: at degree ≥ 5 the
+    /// `u` edges interpolate `X_uu` too).
+    pub degrees: (usize, usize),
     /// Initial spans per direction.
     pub spans: (usize, usize),
     /// The largest control net per direction.
@@ -118,6 +125,11 @@ pub struct FitOptions {
     /// Values of `v` where the patch is only C0 (an N-sided fill's corners): knots of full
     /// multiplicity there, so the spline follows the kink exactly.
     pub v_breaks: Vec<f64>,
+    /// Values of `v` where the patch is only `Cᵏ` (`(v, k)`, `0 < k < degree`; e.g. where
+    /// a fill's corner blends end, `k = 3`): knots of multiplicity `degree − k` there, so
+    /// that the spline space holds the jump of the patch's `(k+1)`-th derivative and the
+    /// fit converges at its full rate across the line instead of at `hᵏ⁺¹`.
+    pub v_joins: Vec<(f64, usize)>,
     /// Interior `v` breakpoints to start from instead of `spans.1` uniform spans (faces
     /// that meet along a `u` edge start from the union of each other's, so that they end
     /// with the same `v` knots and the same edge).
@@ -137,10 +149,11 @@ impl Default for FitOptions {
         FitOptions {
             tolerance: None,
             relative: 1e-6,
-            degree: 3,
+            degrees: (3, 3),
             spans: (4, 8),
             max_points: 400,
             v_breaks: Vec::new(),
+            v_joins: Vec::new(),
             v_start: Vec::new(),
             u_start: Vec::new(),
             edge: None,
@@ -495,13 +508,26 @@ fn local_max(
 
 /// Knots of degree `p` on `[a, b]` with the distinct interior breakpoints `interior`;
 /// those in `c0` (C0 lines of the patch) get multiplicity `p`.
-fn knots_with_breaks(p: usize, a: f64, b: f64, interior: &[f64], c0: &[f64]) -> Knots {
+fn knots_with_breaks(p: usize, a: f64, b: f64, interior: &[f64], c0: &[f64], joins: &[(f64, usize)]) -> Knots {
     let mut k = Vec::with_capacity(interior.len() + c0.len() * p);
     for &x in interior {
-        let m = if c0.contains(&x) { p } else { 1 };
+        let m =
+            if c0.contains(&x) { p } else { joins.iter().find(|j| j.0 == x).map_or(1, |j| join_multiplicity(p, j.1)) };
         k.extend(std::iter::repeat_n(x, m));
     }
     Knots::clamped(p, a, b, &k)
+}
+
+/// The multiplicity of a knot of degree `p` where the patch is `Cᵏ`: `p − k`, at least 1.
+fn join_multiplicity(p: usize, k: usize) -> usize {
+    p.saturating_sub(k).max(1)
+}
+
+/// Control points of degree `p` on `interior` distinct breakpoints, of which `c0` are of
+/// full multiplicity and `joins` (not also in `c0`) of [`join_multiplicity`].
+fn control_count(p: usize, interior: usize, c0: &[f64], joins: &[(f64, usize)]) -> usize {
+    let extra: usize = joins.iter().filter(|j| !c0.contains(&j.0)).map(|j| join_multiplicity(p, j.1) - 1).sum();
+    interior + c0.len() * (p - 1) + extra + p + 1
 }
 
 /// `∂ᵖS/∂uᵖ` (`dir` 0) or `∂^qS/∂v^q` at `(u, v)`: constant in that direction within a span.
@@ -571,12 +597,14 @@ struct Axis {
     hi: f64,
     interior: Vec<f64>,
     c0: Vec<f64>,
+    /// Lines where the patch is `Cᵏ` only (`(place, k)`, among `interior`).
+    joins: Vec<(f64, usize)>,
     searched: Vec<(f64, f64)>,
     first_span: f64,
 }
 
 impl Axis {
-    fn new(lo: f64, hi: f64, spans: usize, c0: &[f64]) -> Axis {
+    fn new(lo: f64, hi: f64, spans: usize, c0: &[f64], joins: &[(f64, usize)]) -> Axis {
         let even =
             |a: f64, b: f64, n: usize| -> Vec<f64> { (1..n).map(|i| a + (b - a) * i as f64 / n as f64).collect() };
         let c0: Vec<f64> = c0.iter().copied().filter(|&x| x > lo && x < hi).collect();
@@ -591,11 +619,21 @@ impl Axis {
             }
             interior.extend(even(w[0], w[1], per));
         }
-        Axis { lo, hi, interior, c0, searched: Vec::new(), first_span: (hi - lo) / (spans.max(1) as f64) }
+        let joins: Vec<(f64, usize)> =
+            joins.iter().copied().filter(|&(x, _)| x > lo && x < hi && !c0.contains(&x)).collect();
+        interior.extend(joins.iter().map(|j| j.0));
+        interior.sort_by(f64::total_cmp);
+        interior.dedup();
+        Axis { lo, hi, interior, c0, joins, searched: Vec::new(), first_span: (hi - lo) / (spans.max(1) as f64) }
     }
 
     fn knots(&self, p: usize) -> Knots {
-        knots_with_breaks(p, self.lo, self.hi, &self.interior, &self.c0)
+        knots_with_breaks(p, self.lo, self.hi, &self.interior, &self.c0, &self.joins)
+    }
+
+    /// The lines across which the patch's `p`-th derivative may jump: C0 lines and joins.
+    fn rough(&self) -> Vec<f64> {
+        self.c0.iter().copied().chain(self.joins.iter().map(|j| j.0)).collect()
     }
 
     /// Adds a C0 line at `x` (snapped to an existing breakpoint within 1e-12 of the span).
@@ -617,7 +655,7 @@ impl Axis {
 
     /// Control points with `interior` as breakpoints.
     fn count(&self, interior: &[f64], p: usize) -> usize {
-        interior.len() + self.c0.len() * (p - 1) + p + 1
+        control_count(p, interior.len(), &self.c0, &self.joins)
     }
 }
 
@@ -665,25 +703,28 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
     if !(tol.is_finite() && tol > 0.0) {
         return Err(FitError::BadTolerance(tol));
     }
-    let p = o.degree;
-    let mut axes = [Axis::new(0.0, 1.0, o.spans.0, &[]), Axis::new(dom.start, dom.end, o.spans.1, &o.v_breaks)];
+    let (p, q) = o.degrees;
+    let mut axes =
+        [Axis::new(0.0, 1.0, o.spans.0, &[], &[]), Axis::new(dom.start, dom.end, o.spans.1, &o.v_breaks, &o.v_joins)];
     for (ax, start) in axes.iter_mut().zip([&o.u_start, &o.v_start]) {
         if start.is_empty() {
             continue;
         }
         let mut iv: Vec<f64> = start.iter().copied().filter(|&x| x > ax.lo && x < ax.hi).collect();
         iv.extend(&ax.c0);
+        iv.extend(ax.joins.iter().map(|j| j.0));
         iv.sort_by(f64::total_cmp);
         iv.dedup();
         ax.interior = iv;
     }
     if let Some(t) = &o.edge {
         let ax = &mut axes[1];
-        ax.interior = edge::edge_breakpoints(s, p, (ax.lo, ax.hi), ax.interior.clone(), &ax.c0, t, o.max_points)?;
+        ax.interior =
+            edge::edge_breakpoints(s, q, (ax.lo, ax.hi), ax.interior.clone(), (&ax.c0, &ax.joins), t, o.max_points)?;
     }
     let mut samples = 0;
     for round in 1.. {
-        let (ku, kv) = (axes[0].knots(p), axes[1].knots(p));
+        let (ku, kv) = (axes[0].knots(p), axes[1].knots(q));
         let b = fit_on(s, &ku, &kv)?;
         let (cells, n) = cell_deviations(s, &b, tol);
         samples += n;
@@ -721,8 +762,8 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
                     }
                 }
             }
-            let wu = direction_weight(&b, 0, &bk[0], &axes[0].c0, ij[0], c.2);
-            let wv = direction_weight(&b, 1, &bk[1], &axes[1].c0, ij[1], c.1);
+            let wu = direction_weight(&b, 0, &bk[0], &axes[0].rough(), ij[0], c.2);
+            let wv = direction_weight(&b, 1, &bk[1], &axes[1].rough(), ij[1], c.1);
             let m = crate::num::max_nan(wu, wv);
             let (a, bb) = if m.is_nan() { (true, true) } else { (wu >= 0.25 * m, wv >= 0.25 * m) };
             // halved (more pieces at once, from the h^(p+1) rate, measured slower: the
@@ -743,7 +784,7 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
                 refine(&b, &marks)
             })
             .collect();
-        if axes[0].count(&next[0], p) > o.max_points || axes[1].count(&next[1], p) > o.max_points {
+        if axes[0].count(&next[0], p) > o.max_points || axes[1].count(&next[1], q) > o.max_points {
             return Err(FitError::Tolerance {
                 tolerance: tol,
                 deviation: worst.0,

@@ -138,7 +138,8 @@ fn quintic_faces_meet_the_tolerance_and_interpolate_the_second_cross_derivative(
     let tau = std::f64::consts::TAU;
     let tol = 1e-8;
     let (b3, r3) = fit_surface(&s, &FitOptions { tolerance: Some(tol), ..Default::default() }).unwrap();
-    let (b5, r5) = fit_surface(&s, &FitOptions { tolerance: Some(tol), degree: 5, ..Default::default() }).unwrap();
+    let (b5, r5) =
+        fit_surface(&s, &FitOptions { tolerance: Some(tol), degrees: (5, 5), ..Default::default() }).unwrap();
     assert_eq!((b5.u.degree, b5.v.degree), (5, 5));
     assert!(r5.max_deviation <= tol);
     let worst =
@@ -192,7 +193,7 @@ impl crate::patch::Surface for Band {
 #[test]
 fn the_edge_meets_its_own_gap_angle_and_curvature_tolerances() {
     let tol = EdgeTolerance { gap: 1e-12, angle: 1e-10, curvature: Some(1e-8), scale: 2.0 };
-    let base = FitOptions { tolerance: Some(1e-6), degree: 5, ..Default::default() };
+    let base = FitOptions { tolerance: Some(1e-6), degrees: (5, 5), ..Default::default() };
     let (plain, _) = fit_surface(&Band, &base).unwrap();
     let (tight, r) = fit_surface(&Band, &FitOptions { edge: Some(tol), max_points: 1000, ..base.clone() }).unwrap();
     assert!(r.max_deviation <= 1e-6, "{r:?}");
@@ -217,4 +218,55 @@ fn the_edge_meets_its_own_gap_angle_and_curvature_tolerances() {
     let (pg, pa, pc) = figures(&plain);
     eprintln!("plain: gap {pg:.2e}, angle {pa:.2e}, curvature {pc:.2e}");
     assert!(pa > 100.0 * tol.angle && pc > 100.0 * 1e-8, "{pa} {pc}");
+}
+
+/// `(u, v, (1 + u) (v − c)₊⁴)` on `v ∈ [0, 1]`: C³ across `v = c`, its fourth `v`-derivative
+/// jumps there (as an N-sided fill's cross derivatives do where its corner blends end).
+struct Joined(f64);
+
+impl crate::patch::Surface for Joined {
+    fn v_domain(&self) -> crate::patch::VDomain {
+        crate::patch::VDomain::open(0.0, 1.0)
+    }
+    fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
+        let x = (v - self.0).max(0.0);
+        // d^j/dv^j x⁴ = 4!/(4−j)! x^(4−j)
+        let g =
+            |j: usize| if j > 4 { 0.0 } else { (0..j).map(|i| (4 - i) as f64).product::<f64>() * x.powi(4 - j as i32) };
+        let mut out = Vec::new();
+        for i in 0..=du {
+            for j in 0..=dv {
+                let lin = [1.0 + u, 1.0, 0.0][i.min(2)];
+                let x = [u, 1.0, 0.0][i.min(2)] * [1.0, 0.0][j.min(1)];
+                let y = [v, 1.0, 0.0][j.min(2)] * [1.0, 0.0][i.min(1)];
+                out.push(Vec3::new(x, y, lin * g(j)));
+            }
+        }
+        out
+    }
+}
+
+/// A `C³` line given as a join gets a knot of multiplicity `degree − 3`, and then the
+/// spline space holds the patch, `(v − c)₊⁴` times a linear function of `u`: the first fit
+/// reproduces it to round-off at degrees 5 and 7. Given no join, the fit needs more rounds
+/// (a simple knot at `c`, or none, cannot follow the jump of the fourth derivative).
+#[test]
+fn a_c3_join_gets_its_knots_and_the_patch_is_reproduced() {
+    let c = 0.37;
+    for q in [5, 7] {
+        // values up to ~0.4 (0.63⁴ × 2): round-off ~1e-16; the tolerance leaves 100×
+        let base = FitOptions { tolerance: Some(1e-14), degrees: (3, q), max_points: 200, ..Default::default() };
+        let joined = FitOptions { v_joins: vec![(c, 3)], ..base.clone() };
+        let (b, r) = fit_surface(&Joined(c), &joined).unwrap();
+        assert_eq!(r.rounds, 1, "degree {q}: {r:?}");
+        assert_eq!(b.v.knots.iter().filter(|&&k| k == c).count(), q - 3, "degree {q}: {:?}", b.v.knots);
+        for (u, v) in points(2000, 0.0, 1.0) {
+            let d = (b.point(u, v) - Joined(c).point(u, v)).norm();
+            assert!(d < 1e-14, "degree {q}, ({u}, {v}): {d}");
+        }
+        match fit_surface(&Joined(c), &base) {
+            Ok((_, r)) => assert!(r.rounds > 1, "degree {q} without the join: {r:?}"),
+            Err(e) => assert!(e.to_string().contains("was not reached"), "{e}"),
+        }
+    }
 }
