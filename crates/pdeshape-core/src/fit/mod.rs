@@ -530,10 +530,57 @@ fn control_count(p: usize, interior: usize, c0: &[f64], joins: &[(f64, usize)]) 
     interior + c0.len() * (p - 1) + extra + p + 1
 }
 
-/// `∂ᵖS/∂uᵖ` (`dir` 0) or `∂^qS/∂v^q` at `(u, v)`: constant in that direction within a span.
-fn top_derivative(b: &BSplineSurface, dir: usize, u: f64, v: f64) -> Vec3 {
-    let (p, q) = (b.u.degree, b.v.degree);
-    if dir == 0 { b.derivatives(u, v, p, 0)[p] } else { b.derivatives(u, v, 0, q)[q] }
+/// The spline's top derivatives, `∂ᵖS/∂uᵖ` and `∂^qS/∂v^q`, which are constant across a
+/// span in their direction: the weights of the basis functions' top derivative are
+/// computed once per breakpoint span and direction (a round's refinement asks for them
+/// from every cell above the tolerance), and summed with the other direction's values at
+/// the asked parameter in the order [`BSplineSurface::derivatives`] sums them.
+struct TopDerivatives<'a> {
+    b: &'a BSplineSurface,
+    /// Per direction and breakpoint span.
+    weights: [Vec<Option<SpanWeights>>; 2],
+}
+
+/// A knot span's index and its basis functions' weights.
+type SpanWeights = (usize, Vec<f64>);
+
+impl<'a> TopDerivatives<'a> {
+    fn new(b: &'a BSplineSurface, bk: &[Vec<f64>; 2]) -> Self {
+        TopDerivatives { b, weights: [vec![None; bk[0].len() - 1], vec![None; bk[1].len() - 1]] }
+    }
+
+    /// The other direction's basis values at `w` (for [`Self::at`]).
+    fn other(&self, dir: usize, w: f64) -> SpanWeights {
+        let (span, mut d) = if dir == 0 { self.b.v.basis(w, 0) } else { self.b.u.basis(w, 0) };
+        (span, d.swap_remove(0))
+    }
+
+    /// `∂ᵖS/∂uᵖ` (`dir` 0) on breakpoint span `k` (through its point `mid`) at `v = w`, or
+    /// `∂^qS/∂v^q` on span `k` at `u = w`, with `(so, wo)` [`Self::other`] at `w`.
+    fn at(&mut self, dir: usize, k: usize, mid: f64, (so, wo): (usize, &[f64])) -> Vec3 {
+        let b = self.b;
+        let top_knots = if dir == 0 { &b.u } else { &b.v };
+        let (st, top) = self.weights[dir][k].get_or_insert_with(|| {
+            let (span, mut d) = top_knots.basis(mid, top_knots.degree);
+            (span, d.pop().expect("the top order"))
+        });
+        let (p, q, cols) = (b.u.degree, b.v.degree, b.v.count());
+        // over u's weights outside, v's inside, as `derivatives` does
+        let ((su, wu), (sv, wv)) = if dir == 0 { ((*st, &top[..]), (so, wo)) } else { ((so, wo), (*st, &top[..])) };
+        let mut s = Vec3::ZERO;
+        for (r, &a) in wu.iter().enumerate() {
+            if a == 0.0 {
+                continue;
+            }
+            let row = (su - p + r) * cols;
+            let mut t = Vec3::ZERO;
+            for (c, &x) in wv.iter().enumerate() {
+                t += b.control[row + sv - q + c] * x;
+            }
+            s += t * a;
+        }
+        s
+    }
 }
 
 /// One direction's refinement weight for span `i` of `bk` (through the other parameter
@@ -541,9 +588,9 @@ fn top_derivative(b: &BSplineSurface, dir: usize, u: f64, v: f64) -> Vec3 {
 /// interior knots that are not C0 lines. The jump is `≈ h |∂ᵖ⁺¹X|`, so this estimates that
 /// direction's interpolation error `O(hᵖ⁺¹ |∂ᵖ⁺¹X|)` from the fit itself. Infinite when no
 /// such knot exists (a single span must be split to learn anything).
-fn direction_weight(b: &BSplineSurface, dir: usize, bk: &[f64], c0: &[f64], i: usize, w: f64) -> f64 {
-    let mid = |k: usize| 0.5 * (bk[k] + bk[k + 1]);
-    let d = |k: usize| if dir == 0 { top_derivative(b, 0, mid(k), w) } else { top_derivative(b, 1, w, mid(k)) };
+fn direction_weight(tops: &mut TopDerivatives, dir: usize, bk: &[f64], c0: &[f64], i: usize, w: f64) -> f64 {
+    let (so, wo) = tops.other(dir, w);
+    let mut d = |k: usize| tops.at(dir, k, 0.5 * (bk[k] + bk[k + 1]), (so, &wo));
     let here = d(i);
     let mut jump = f64::NEG_INFINITY;
     if i > 0 && !c0.contains(&bk[i]) {
@@ -555,7 +602,7 @@ fn direction_weight(b: &BSplineSurface, dir: usize, bk: &[f64], c0: &[f64], i: u
     if jump == f64::NEG_INFINITY {
         return f64::INFINITY;
     }
-    let p = if dir == 0 { b.u.degree } else { b.v.degree };
+    let p = if dir == 0 { tops.b.u.degree } else { tops.b.v.degree };
     jump * (bk[i + 1] - bk[i]).powi(p as i32)
 }
 
@@ -746,6 +793,7 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
             return Ok((b, report));
         }
         let mut split = [vec![false; bk[0].len() - 1], vec![false; ncv]];
+        let mut tops = TopDerivatives::new(&b, &bk);
         for (k, c) in cells.iter().enumerate() {
             if c.0 <= tol {
                 continue;
@@ -762,8 +810,8 @@ pub fn fit_surface(s: &dyn Surface, o: &FitOptions) -> Result<(BSplineSurface, F
                     }
                 }
             }
-            let wu = direction_weight(&b, 0, &bk[0], &axes[0].rough(), ij[0], c.2);
-            let wv = direction_weight(&b, 1, &bk[1], &axes[1].rough(), ij[1], c.1);
+            let wu = direction_weight(&mut tops, 0, &bk[0], &axes[0].rough(), ij[0], c.2);
+            let wv = direction_weight(&mut tops, 1, &bk[1], &axes[1].rough(), ij[1], c.1);
             let m = crate::num::max_nan(wu, wv);
             let (a, bb) = if m.is_nan() { (true, true) } else { (wu >= 0.25 * m, wv >= 0.25 * m) };
             // halved (more pieces at once, from the h^(p+1) rate, measured slower: the
