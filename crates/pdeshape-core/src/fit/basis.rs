@@ -86,6 +86,31 @@ impl Knots {
         lo
     }
 
+    /// The `p + 1` non-zero basis functions' values at `x` into `out` (`p + 1` long), without
+    /// allocating; returns the span. The recurrence and its operations are those of
+    /// [`Knots::basis`] (The NURBS Book's A2.2 is A2.3's first table), so the values are
+    /// the same bits.
+    pub fn values_into(&self, x: f64, out: &mut [f64]) -> usize {
+        let p = self.degree;
+        let i = self.span(x);
+        let u = &self.knots;
+        let mut left: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; p + 1];
+        let mut right: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; p + 1];
+        out[0] = 1.0;
+        for j in 1..=p {
+            left[j] = x - u[i + 1 - j];
+            right[j] = u[i + j] - x;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let temp = out[r] / (right[r + 1] + left[j - r]);
+                out[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            out[j] = saved;
+        }
+        i
+    }
+
     /// The `p + 1` non-zero basis functions at `x` and their derivatives up to order `nd`:
     /// `out[k][r]` is `dᵏ N_{span−p+r}/dxᵏ`; returns the span.
     pub fn basis(&self, x: f64, nd: usize) -> (usize, Vec<Vec<f64>>) {
@@ -100,6 +125,21 @@ impl Knots {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `values_into` gives the bits of `basis`' values, at knots, between them and at the
+    /// ends, on clamped knots with a double interior knot, degrees 1 to 9.
+    #[test]
+    fn values_into_is_basis_bit_for_bit() {
+        for p in 1..=9 {
+            let k = Knots::clamped(p, -1.0, 2.5, &[-0.3, 0.1, 0.1, 0.7, 1.9]);
+            let mut out = vec![f64::NAN; p + 1];
+            for x in [-1.0, -0.7, -0.3, 0.0, 0.1, 0.45, 1.9, 2.2, 2.5] {
+                let (span, d) = k.basis(x, 0);
+                assert_eq!(k.values_into(x, &mut out), span, "degree {p} at {x}");
+                assert_eq!(out, d[0], "degree {p} at {x}");
+            }
+        }
+    }
 
     /// Partition of unity, derivatives summing to 0, and the cubic Bézier case by hand
     /// (one span: Bernstein polynomials `C(3, r) xʳ (1 − x)³⁻ʳ` and their derivatives).

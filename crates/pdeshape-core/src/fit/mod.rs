@@ -85,9 +85,27 @@ impl BSplineSurface {
         out
     }
 
-    /// `S(u, v)`.
+    /// `S(u, v)` (the bits of `derivatives(u, v, 0, 0)[0]`, without allocating).
     pub fn point(&self, u: f64, v: f64) -> Vec3 {
-        self.derivatives(u, v, 0, 0)[0]
+        let (p, q) = (self.u.degree, self.v.degree);
+        let mut nu: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; p + 1];
+        let mut nv: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; q + 1];
+        let su = self.u.values_into(u, &mut nu);
+        let sv = self.v.values_into(v, &mut nv);
+        let cols = self.v.count();
+        let mut s = Vec3::ZERO;
+        for (r, &wu) in nu.iter().enumerate() {
+            if wu == 0.0 {
+                continue;
+            }
+            let row = (su - p + r) * cols;
+            let mut t = Vec3::ZERO;
+            for (c, &wv) in nv.iter().enumerate() {
+                t += self.control[row + sv - q + c] * wv;
+            }
+            s += t * wu;
+        }
+        s
     }
 
     /// The boundary isocurve `u = 0` (`end` false) or `u = 1` as its control points (the
@@ -290,25 +308,22 @@ const K: usize = 7;
 /// first reduced to a curve's control points, then evaluated at every `v`.
 fn spline_grid(b: &BSplineSurface, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
     let (p, q, nv) = (b.u.degree, b.v.degree, b.v.count());
-    let vb: Vec<(usize, Vec<f64>)> = vs
-        .iter()
-        .map(|&v| {
-            let (sp, d) = b.v.basis(v, 0);
-            (sp, d.into_iter().next().expect("order 0"))
-        })
-        .collect();
+    // the v basis of every column, q + 1 values each
+    let mut vw = vec![0.0; vs.len() * (q + 1)];
+    let vspan: Vec<usize> = vs.iter().zip(vw.chunks_mut(q + 1)).map(|(&v, w)| b.v.values_into(v, w)).collect();
     let mut out = Vec::with_capacity(us.len() * vs.len());
     let mut row = vec![Vec3::ZERO; nv];
+    let mut uw = vec![0.0; p + 1];
     for &u in us {
-        let (su, d) = b.u.basis(u, 0);
+        let su = b.u.values_into(u, &mut uw);
         row.iter_mut().for_each(|x| *x = Vec3::ZERO);
-        for (r, &w) in d[0].iter().enumerate() {
+        for (r, &w) in uw.iter().enumerate() {
             let base = (su - p + r) * nv;
             for (j, x) in row.iter_mut().enumerate() {
                 *x += b.control[base + j] * w;
             }
         }
-        for (sv, w) in &vb {
+        for (sv, w) in vspan.iter().zip(vw.chunks(q + 1)) {
             let mut x = Vec3::ZERO;
             for (c, &wc) in w.iter().enumerate() {
                 x += row[sv - q + c] * wc;
