@@ -62,50 +62,43 @@ impl BSplineSurface {
     pub fn derivatives(&self, u: f64, v: f64, du: usize, dv: usize) -> Vec<Vec3> {
         let (su, nu) = self.u.basis(u, du);
         let (sv, nv) = self.v.basis(v, dv);
-        let (p, q) = (self.u.degree, self.v.degree);
-        let cols = self.v.count();
         let mut out = vec![Vec3::ZERO; (du + 1) * (dv + 1)];
         for a in 0..=du {
             for b in 0..=dv {
-                let mut s = Vec3::ZERO;
-                for (r, &wu) in nu[a].iter().enumerate() {
-                    if wu == 0.0 {
-                        continue;
-                    }
-                    let row = (su - p + r) * cols;
-                    let mut t = Vec3::ZERO;
-                    for (c, &wv) in nv[b].iter().enumerate() {
-                        t += self.control[row + sv - q + c] * wv;
-                    }
-                    s += t * wu;
-                }
-                out[a * (dv + 1) + b] = s;
+                out[a * (dv + 1) + b] = self.sum((su, &nu[a]), (sv, &nv[b]));
             }
         }
         out
     }
 
-    /// `S(u, v)` (the bits of `derivatives(u, v, 0, 0)[0]`, without allocating).
-    pub fn point(&self, u: f64, v: f64) -> Vec3 {
-        let (p, q) = (self.u.degree, self.v.degree);
-        let mut nu: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; p + 1];
-        let mut nv: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; q + 1];
-        let su = self.u.values_into(u, &mut nu);
-        let sv = self.v.values_into(v, &mut nv);
-        let cols = self.v.count();
+    /// `Σᵣ Σ_c wuᵣ wv_c P_{su−p+r, sv−q+c}`: the net weighted by `u` weights on knot span
+    /// `su` and `v` weights on `sv` (the values or derivatives of the basis functions there),
+    /// summed over `v` inside and `u` outside, a zero `u` weight skipped. Every evaluation
+    /// of the surface sums in this one order, so its results agree to the bit.
+    fn sum(&self, (su, wu): (usize, &[f64]), (sv, wv): (usize, &[f64])) -> Vec3 {
+        let (p, q, cols) = (self.u.degree, self.v.degree, self.v.count());
         let mut s = Vec3::ZERO;
-        for (r, &wu) in nu.iter().enumerate() {
-            if wu == 0.0 {
+        for (r, &a) in wu.iter().enumerate() {
+            if a == 0.0 {
                 continue;
             }
             let row = (su - p + r) * cols;
             let mut t = Vec3::ZERO;
-            for (c, &wv) in nv.iter().enumerate() {
-                t += self.control[row + sv - q + c] * wv;
+            for (c, &x) in wv.iter().enumerate() {
+                t += self.control[row + sv - q + c] * x;
             }
-            s += t * wu;
+            s += t * a;
         }
         s
+    }
+
+    /// `S(u, v)` (the bits of `derivatives(u, v, 0, 0)[0]`, without allocating).
+    pub fn point(&self, u: f64, v: f64) -> Vec3 {
+        let mut nu: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; self.u.degree + 1];
+        let mut nv: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; self.v.degree + 1];
+        let su = self.u.values_into(u, &mut nu);
+        let sv = self.v.values_into(v, &mut nv);
+        self.sum((su, &nu), (sv, &nv))
     }
 
     /// The boundary isocurve `u = 0` (`end` false) or `u = 1` as its control points (the
@@ -143,10 +136,11 @@ pub struct FitOptions {
     /// Values of `v` where the patch is only C0 (an N-sided fill's corners): knots of full
     /// multiplicity there, so the spline follows the kink exactly.
     pub v_breaks: Vec<f64>,
-    /// Values of `v` where the patch is only `Cᵏ` (`(v, k)`, `0 < k < degree`; e.g. where
-    /// a fill's corner blends end, `k = 3`): knots of multiplicity `degree − k` there, so
-    /// that the spline space holds the jump of the patch's `(k+1)`-th derivative and the
-    /// fit converges at its full rate across the line instead of at `hᵏ⁺¹`.
+    /// Values of `v` where the patch is only `Cᵏ` (`(v, k)`, `0 < k < q`, `q` the `v`
+    /// degree; e.g. where a fill's corner blends end, `k = 3`): knots of multiplicity
+    /// `q − k` there (at least 1), so that the spline space holds the jump of the patch's
+    /// `(k+1)`-th derivative and the fit converges at its full rate across the line
+    /// instead of at `hᵏ⁺¹`.
     pub v_joins: Vec<(f64, usize)>,
     /// Interior `v` breakpoints to start from instead of `spans.1` uniform spans (faces
     /// that meet along a `u` edge start from the union of each other's, so that they end
@@ -549,7 +543,7 @@ fn control_count(p: usize, interior: usize, c0: &[f64], joins: &[(f64, usize)]) 
 /// span in their direction: the weights of the basis functions' top derivative are
 /// computed once per breakpoint span and direction (a round's refinement asks for them
 /// from every cell above the tolerance), and summed with the other direction's values at
-/// the asked parameter in the order [`BSplineSurface::derivatives`] sums them.
+/// the asked parameter as [`BSplineSurface::derivatives`] sums them.
 struct TopDerivatives<'a> {
     b: &'a BSplineSurface,
     /// Per direction and breakpoint span.
@@ -579,22 +573,8 @@ impl<'a> TopDerivatives<'a> {
             let (span, mut d) = top_knots.basis(mid, top_knots.degree);
             (span, d.pop().expect("the top order"))
         });
-        let (p, q, cols) = (b.u.degree, b.v.degree, b.v.count());
-        // over u's weights outside, v's inside, as `derivatives` does
-        let ((su, wu), (sv, wv)) = if dir == 0 { ((*st, &top[..]), (so, wo)) } else { ((so, wo), (*st, &top[..])) };
-        let mut s = Vec3::ZERO;
-        for (r, &a) in wu.iter().enumerate() {
-            if a == 0.0 {
-                continue;
-            }
-            let row = (su - p + r) * cols;
-            let mut t = Vec3::ZERO;
-            for (c, &x) in wv.iter().enumerate() {
-                t += b.control[row + sv - q + c] * x;
-            }
-            s += t * a;
-        }
-        s
+        let (st, top) = (*st, &top[..]);
+        if dir == 0 { b.sum((st, top), (so, wo)) } else { b.sum((so, wo), (st, top)) }
     }
 }
 
