@@ -1,7 +1,8 @@
 //! The holes of an imported model: listed (a typed report for `holes` and its JSON), and
 //! filled — each hole by a fill of order 4 (G1) or 6 (G2) from the faces around
-//! (`pdeshape_core::brep::fill_hole`), fitted by a B-spline face of degree 5 that
-//! interpolates the fill's cross derivatives at the loop, measured against the exact
+//! (`pdeshape_core::brep::fill_hole`), fitted by a B-spline face of degree 9 (knots of
+//! multiplicity 6 where the fill's corner blends end) that interpolates the fill's cross
+//! derivatives at the loop, measured against the exact
 //! faces around after the fit, and sewn into the model (`export::sewn_step`).
 
 use crate::export::{SewnFace, sewn_step, write_atomic};
@@ -374,7 +375,7 @@ pub fn seam_tolerance(order: usize, size: f64) -> EdgeTolerance {
 }
 
 /// Fits the fill `fill` (of order `order`) of hole `index` (from 1) of `m` by a B-spline
-/// face of degree 5 (interpolating the fill's first and second cross derivatives along the
+/// face of degree 9 (interpolating the fill's first and second cross derivatives along the
 /// loop) to `relative` of the model's size, its edge along the loop to [`seam_tolerance`],
 /// and measures the seam of the face against the faces around.
 pub fn fit_filled(
