@@ -187,8 +187,9 @@ impl LoopData {
     /// end. A blend moves nothing when, at its corner, its change of the cross tangent
     /// `(a − c) S_s + b S_w + g N` is at most 1e-12 of `|c S_s|` and (order-6 data) the change
     /// `γ S_s + δ S_w + η N` of the second cross derivative at most 1e-12 of `|c S_s|² κ`,
-    /// `κ` the larger of `|S_ss| / |S_s|²` and `|S_ww| / |S_w|²` (the ends of a single closed smooth edge, whose corner is the same point from both
-    /// sides: there the means equal each side's own data).
+    /// `κ` the larger of `|S_ss| / |S_s|²` and `|S_ww| / |S_w|²`. So it is at the corners
+    /// of a closed smooth edge cut into pieces (as a CAD model's single closed edge is):
+    /// both sides see such a corner alike, and the means equal each side's own data.
     pub fn blend_joins(&self, t: f64) -> Vec<(f64, usize)> {
         let n = self.pieces.len();
         let span = TAU / n as f64;

@@ -92,11 +92,11 @@ const K: usize = 8;
 
 /// The `v` interior breakpoints (C0 lines `c0` kept, of full multiplicity, and `Cᵏ` lines
 /// `joins`, of multiplicity `p − k`) from which the fit of `s` of degree `p` on `[lo, hi]`
-/// meets `tol` along its `u = 0` edge: a span that
-/// misses by a factor `m` is cut into `⌈(1.2 m)^(1/p)⌉` equal pieces (at least two; the
-/// edge's angle error falls like `hᵖ` with the span `h`, its gap like `hᵖ⁺¹`), until every
-/// sample meets it or the net would exceed `max_points` in `v` (then the breakpoints
-/// reached; the final measure of the written face reports the edge).
+/// meets `tol` along its `u = 0` edge: a span that misses by a factor `m` is cut into
+/// `⌈(1.2 m)^(1/p)⌉` equal pieces (at least two; the edge's angle error falls like `hᵖ`
+/// with the span `h`, its gap like `hᵖ⁺¹`), until every sample meets it or the net would
+/// exceed `max_points` in `v` (then the breakpoints reached; the final measure of the
+/// written face reports the edge).
 pub(super) fn edge_breakpoints(
     s: &dyn Surface,
     p: usize,
