@@ -7,9 +7,11 @@
 //! whose isoline `σ = 0` is `S(c(τ))`. `R` is the same surface near the curve (a change of
 //! parameters), so positions, tangent planes and second fundamental forms along the edge are
 //! the neighbour's; the fill's isoline machinery ([`super::FillEdge`]) applies unchanged.
-//! Derivatives are exact: with `δu(σ, τ)`, `δv(σ, τ)` the Taylor polynomials of the map
-//! `(σ, τ) ↦ c(τ) + σ ν(τ)` around the point (exact derivatives of `c`),
-//! `R = Σ_{i+j≤K} ∂ᵢ∂ⱼS/(i! j!) δuⁱ δvʲ` truncated at the requested total order `K`.
+//! Derivatives are exact (exact derivatives of `c` and of `S`, combined by Taylor
+//! arithmetic): as `R` is linear in `σ` inside `S`, its coefficient of `δσᵃ` is
+//! `Σ_{i+j=a} ν₁ⁱ ν₂ʲ ∂ᵢ∂ⱼS(p(τ))/(i! j!)` with `p = c + σ₀ ν`, and each `∂ᵢ∂ⱼS(p(τ))` is
+//! the host's Taylor expansion at `p(τ₀)` composed with `δp(τ)`: products of series in
+//! `δτ` alone (see [`AlongCurve`]'s `jet`).
 
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
@@ -111,50 +113,83 @@ impl Field for AlongCurve {
         if k == 0 {
             return VecJet::constant(shape, d[0]);
         }
-        // Taylor series in τ of c and ν = (−c₂′, c₁′)
+        // With p(τ) = c(τ) + σ₀ ν(τ) and ν = (−c₂′, c₁′), expanding in δσ and then along p,
+        //
+        //   R(σ₀ + δσ, τ₀ + δτ) = Σ_a δσᵃ Σ_{i+j=a} ν₁ⁱ ν₂ʲ T_ij,
+        //   T_ij = ∂ᵢ∂ⱼS(p(τ))/(i! j!) = Σ_{m+n≤K} C(i+m, i) C(j+n, j) d_{i+m, j+n} δp₁ᵐ δp₂ⁿ,
+        //
+        // with d_IJ the host's Taylor coefficients at p(τ₀) and δp = p(τ) − p(τ₀): every
+        // factor a series in δτ alone (truncated at K = kw), so the coefficient of δσᵃ δτᵇ
+        // needs only products of one-variable series.
+        let n = kw + 1;
         let mut fact = 1.0;
-        let (mut cu, mut cv, mut nu, mut nv) = (vec![], vec![], vec![], vec![]);
+        let (mut dp1, mut dp2, mut nu1, mut nu2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for m in 0..=kw {
             if m > 0 {
                 fact *= m as f64;
+                dp1[m] = (c[m][0] - sigma * c[m + 1][1]) / fact;
+                dp2[m] = (c[m][1] + sigma * c[m + 1][0]) / fact;
             }
-            cu.push(c[m][0] / fact);
-            cv.push(c[m][1] / fact);
-            nu.push(-c[m + 1][1] / fact);
-            nv.push(c[m + 1][0] / fact);
+            nu1[m] = -c[m + 1][1] / fact;
+            nu2[m] = c[m + 1][0] / fact;
         }
-        // δu(σ, τ) = c₁(τ) + σ ν₁(τ) − u₀ as a jet in (δσ, δτ): the Taylor coefficients
-        // of c₁ + σ₀ ν₁ along τ, those of ν₁ one order up in σ (the value cancels u₀)
-        let offset = |c: &[f64], n: &[f64]| {
-            let mut x = vec![0.0; shape.len()];
-            for j in 1..=kw {
-                x[shape.index([0, j, 0])] = c[j] + sigma * n[j];
-                if ks >= 1 {
-                    x[shape.index([1, j, 0])] = n[j];
-                }
+        // the truncated product of two series of length n, into `o`
+        let mul = |a: &[f64], b: &[f64], o: &mut [f64]| {
+            for (l, x) in o.iter_mut().enumerate() {
+                *x = (0..=l).map(|i| a[i] * b[l - i]).sum();
             }
-            if ks >= 1 {
-                x[shape.index([1, 0, 0])] = n[0];
-            }
-            Jet::from_coeffs(shape, x)
         };
-        let (du, dv) = (offset(&cu, &nu), offset(&cv, &nv));
-        let mut out = [vec![0.0; shape.len()], vec![0.0; shape.len()], vec![0.0; shape.len()]];
-        let mut du_pow = Jet::constant(shape, 1.0);
-        for i in 0..=k {
-            if i > 0 {
-                du_pow = du_pow.mul(&du);
+        // xᵐ for m = 0 … top, each a series of length n, flat
+        let powers = |x: &[f64], top: usize| -> Vec<f64> {
+            let mut p = vec![0.0; (top + 1) * n];
+            p[0] = 1.0;
+            for m in 1..=top {
+                let (done, next) = p.split_at_mut(m * n);
+                mul(&done[(m - 1) * n..], x, &mut next[..n]);
             }
-            let mut term = du_pow.clone();
-            for j in 0..=k - i {
-                if j > 0 {
-                    term = term.mul(&dv);
-                }
-                let coef = d[i * (k + 1) + j];
-                for (o, x) in out.iter_mut().zip([coef.x, coef.y, coef.z]) {
-                    for (a, t) in o.iter_mut().zip(term.coeffs()) {
-                        *a += x * t;
+            p
+        };
+        let (pw1, pw2) = (powers(&dp1, kw), powers(&dp2, kw));
+        let (nw1, nw2) = (powers(&nu1, ks), powers(&nu2, ks));
+        // δp₁ᵐ δp₂ˡ for m + l ≤ kw, with their (m, l)
+        let mut mixed = Vec::with_capacity((kw + 1) * (kw + 2) / 2 * n);
+        let mut ml = Vec::with_capacity((kw + 1) * (kw + 2) / 2);
+        let mut q = vec![0.0; n];
+        for m in 0..=kw {
+            for l in 0..=kw - m {
+                mul(&pw1[m * n..(m + 1) * n], &pw2[l * n..(l + 1) * n], &mut q);
+                mixed.extend_from_slice(&q);
+                ml.push((m, l));
+            }
+        }
+        // C(a, b) for a ≤ k
+        let mut binom = vec![0.0; (k + 1) * (k + 1)];
+        for a in 0..=k {
+            binom[a * (k + 1)] = 1.0;
+            for b in 1..=a {
+                binom[a * (k + 1) + b] = binom[(a - 1) * (k + 1) + b - 1] + binom[(a - 1) * (k + 1) + b];
+            }
+        }
+        let mut out = [vec![0.0; shape.len()], vec![0.0; shape.len()], vec![0.0; shape.len()]];
+        let (mut tij, mut nn) = (vec![Vec3::ZERO; n], vec![0.0; n]);
+        for a in 0..=ks {
+            for i in 0..=a {
+                let j = a - i;
+                tij.iter_mut().for_each(|t| *t = Vec3::ZERO);
+                for (&(m, l), q) in ml.iter().zip(mixed.chunks_exact(n)) {
+                    let w =
+                        d[(i + m) * (k + 1) + j + l] * (binom[(i + m) * (k + 1) + i] * binom[(j + l) * (k + 1) + j]);
+                    for (t, &x) in tij.iter_mut().zip(q) {
+                        *t += w * x;
                     }
+                }
+                mul(&nw1[i * n..(i + 1) * n], &nw2[j * n..(j + 1) * n], &mut nn);
+                for b in 0..n {
+                    let x = (0..=b).fold(Vec3::ZERO, |acc, r| acc + tij[r] * nn[b - r]);
+                    let idx = shape.index([a, b, 0]);
+                    out[0][idx] += x.x;
+                    out[1][idx] += x.y;
+                    out[2][idx] += x.z;
                 }
             }
         }
@@ -166,6 +201,41 @@ impl Field for AlongCurve {
 mod tests {
     use super::*;
     use crate::data::ExprField;
+
+    /// A transcendental host and an ellipse as the curve, every coefficient up to `∂σ³∂τ⁵`
+    /// against the jets of `R(σ, τ) = S(c(τ) + σ ν(τ))` written out as one expression (the
+    /// expression engine's own Taylor arithmetic: an independent path). The host's Taylor
+    /// coefficients of every order up to 8 enter (a paraboloid's vanish above 2).
+    #[test]
+    fn along_an_ellipse_on_a_transcendental_host() {
+        let host = |s: &str, w: &str| {
+            [format!("exp({s})*cos({w})"), format!("exp({s})*sin({w})"), format!("{s}*{w} + sin({s})")]
+        };
+        let h = host("s", "w");
+        let s = ExprField::parse([&h[0], &h[1], &h[2]], &["s", "w", "t"], &|_| None).unwrap();
+        // c = (0.3 + 0.5 cos τ, 0.2 + 0.7 sin τ), ν = (−c₂′, c₁′) = (−0.7 cos τ, −0.5 sin τ)
+        let c = ExprField::parse(["0.3 + 0.5*cos(t)", "0.2 + 0.7*sin(t)", "0"], &["t"], &|_| None).unwrap();
+        let (su, sv) = ("(0.3 + 0.5*cos(t) - q*0.7*cos(t))", "(0.2 + 0.7*sin(t) - q*0.5*sin(t))");
+        let composed = host(su, sv);
+        let want = ExprField::parse([&composed[0], &composed[1], &composed[2]], &["q", "t", "x"], &|_| None).unwrap();
+        let field = AlongCurve { host: Host::Field(Arc::new(s)), curve: DomainCurve::Field(Arc::new(c)) };
+        let shape = JetShape::new(&[3, 5, 0]);
+        for (sigma, tau) in [(0.0, 0.3), (0.15, 2.0), (-0.2, 4.4)] {
+            let got = field.jet(&[sigma, tau, 0.0], shape);
+            let exact = want.jet(&[sigma, tau, 0.0], shape);
+            for m in shape.multi_indices() {
+                for c in 0..3 {
+                    let (g, w) = (got.0[c].coeff(m), exact.0[c].coeff(m));
+                    // Taylor coefficients of size ≤ ~10, summed in different orders: a few
+                    // ulps of the largest terms
+                    assert!(
+                        (g - w).abs() <= 1e-13 * (1.0 + w.abs()),
+                        "{m:?} component {c} at ({sigma}, {tau}): {g} vs {w}"
+                    );
+                }
+            }
+        }
+    }
 
     /// A curve on a paraboloid against the closed form: `S(s, w) = (s, w, s² + w²)`,
     /// `c(τ) = (cos τ, sin τ)` (the unit circle), so `ν = (−cos τ, −sin τ)` and
