@@ -32,6 +32,9 @@ use crate::num::max_nan;
 /// Nodes per piece: `N + 1` Chebyshev–Lobatto points (degree `N`).
 const N: usize = 20;
 
+/// Derivative orders whose series are kept per piece (beyond: derived at each call).
+const DERIVED: usize = 8;
+
 /// The deepest halving of the edge's range.
 pub const MAX_DEPTH: usize = 14;
 
@@ -44,9 +47,13 @@ const MAX_PIECES: usize = 512;
 pub struct FootSeries {
     /// Piece ends, increasing: piece `i` is `[breaks[i], breaks[i + 1]]`.
     breaks: Vec<f64>,
-    /// Each piece's Chebyshev coefficients of `u` and of `v` (`N + 1` each, `a_0` and
-    /// `a_N` already halved for plain summation).
-    coeffs: Vec<[[f64; N + 1]; 2]>,
+    /// Each piece's Chebyshev coefficients of `u` and of `v` (`derived[i][q][0]`, `N + 1`
+    /// each, `a_0` and `a_N` already halved for plain summation) and their derivative
+    /// series in `x` up to order [`DERIVED`] (`derived[i][q][m]`: [`derivative`] applied `m`
+    /// times, padded with zeros, which Clenshaw's recurrence passes through exactly):
+    /// computed once, so that an evaluation is a few recurrences and nothing else (the same
+    /// bits as deriving anew at each call).
+    derived: Vec<[[[f64; N + 1]; DERIVED + 1]; 2]>,
     /// The largest distance `|S(c̃) − S(c)|` measured between the nodes.
     max_error: f64,
 }
@@ -147,7 +154,23 @@ impl FootSeries {
                 todo.push((a, mid, depth + 1));
             }
         }
-        Some(FootSeries { breaks, coeffs, max_error })
+        let derived = coeffs
+            .iter()
+            .map(|piece: &[[f64; N + 1]; 2]| {
+                piece.map(|c| {
+                    let mut out = [[0.0; N + 1]; DERIVED + 1];
+                    let mut s = c.to_vec();
+                    for (m, o) in out.iter_mut().enumerate() {
+                        if m > 0 {
+                            s = derivative(&s);
+                        }
+                        o[..s.len()].copy_from_slice(&s);
+                    }
+                    out
+                })
+            })
+            .collect();
+        Some(FootSeries { breaks, derived, max_error })
     }
 
     /// The largest distance `|S(c̃) − S(c)|` measured between the nodes.
@@ -157,7 +180,7 @@ impl FootSeries {
 
     /// The number of pieces.
     pub fn pieces(&self) -> usize {
-        self.coeffs.len()
+        self.derived.len()
     }
 
     /// `dᵐc̃/dτᵐ` of `u` and `v` for `m = 0 … k` (the outermost pieces extrapolate).
@@ -168,14 +191,19 @@ impl FootSeries {
         let scale = 2.0 / (b - a);
         let mut out = vec![[0.0; 2]; k + 1];
         for q in 0..2 {
-            let mut s = self.coeffs[i][q].to_vec();
+            let kept = &self.derived[i][q];
+            let mut s = Vec::new();
             let mut f = 1.0;
             for (m, o) in out.iter_mut().enumerate() {
                 if m > 0 {
-                    s = derivative(&s);
                     f *= scale;
                 }
-                o[q] = clenshaw(&s, x) * f;
+                o[q] = if m <= DERIVED {
+                    clenshaw(&kept[m], x) * f
+                } else {
+                    s = derivative(if m == DERIVED + 1 { &kept[DERIVED][..N + 1 - DERIVED] } else { &s });
+                    clenshaw(&s, x) * f
+                };
             }
         }
         out
