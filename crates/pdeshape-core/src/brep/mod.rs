@@ -57,14 +57,13 @@ impl FaceSurface {
             FaceSurface::Nurbs(n) => {
                 let ((u0, u1), (v0, v1)) = n.domain();
                 let k = 48;
+                let us: Vec<f64> = (0..=k).map(|i| u0 + (u1 - u0) * i as f64 / k as f64).collect();
+                let vs: Vec<f64> = (0..=k).map(|j| v0 + (v1 - v0) * j as f64 / k as f64).collect();
                 let mut best = (f64::INFINITY, [u0, v0]);
-                for i in 0..=k {
-                    for j in 0..=k {
-                        let c = [u0 + (u1 - u0) * i as f64 / k as f64, v0 + (v1 - v0) * j as f64 / k as f64];
-                        let d = (n.eval(&c) - p).norm();
-                        if d < best.0 {
-                            best = (d, c);
-                        }
+                for (x, idx) in n.grid_values(&us, &vs).into_iter().zip(0..) {
+                    let d = (x - p).norm();
+                    if d < best.0 {
+                        best = (d, [us[idx / (k + 1)], vs[idx % (k + 1)]]);
                     }
                 }
                 best.1
