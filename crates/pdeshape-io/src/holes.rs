@@ -250,14 +250,16 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
     let mut seeds: Vec<Option<[f64; 2]>> = vec![None; faces.len()];
     // each face's field made once (a closed B-spline face's is periodic, `FaceSurface::field`)
     let fields: Vec<Option<_>> = faces.iter().map(|&fi| b.faces[fi].surface.as_ref().map(|s| s.field())).collect();
+    // the face chosen for the previous sample (its foot is found first, and bounds which
+    // faces can be nearer)
+    let mut previous: Option<usize> = None;
     for i in 0..samples {
         let v = v0 + (v1 - v0) * (i as f64 + 0.5) / samples as f64;
         let d = s.derivatives(0.0, v, 2, 2);
         let p = d[0];
-        // the nearest face around
-        let mut best: Option<(f64, usize, [f64; 2])> = None;
-        for (k, &fi) in faces.iter().enumerate() {
-            let (Some(fs), Some(field)) = (&b.faces[fi].surface, &fields[k]) else { continue };
+        // face k's foot of p from its last foot, and its distance
+        let foot = |k: usize, seed: Option<[f64; 2]>| -> Option<([f64; 2], f64)> {
+            let (Some(fs), Some(field)) = (&b.faces[faces[k]].surface, &fields[k]) else { return None };
             // a foot outside a B-spline face's domain (the last foot carried across a closed
             // face's seam) is on its extrapolation, not on the face: from there moved by the
             // period, or searched afresh
@@ -268,13 +270,37 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
                 }
                 foot_of(field.as_ref(), p, fs.wrap(c), 0.0).filter(|c| fs.in_domain(*c))
             };
-            let Some(c) = seeds[k].and_then(settle).or_else(|| settle(fs.invert_near(p))) else { continue };
+            let c = seed.and_then(settle).or_else(|| settle(fs.invert_near(p)))?;
+            Some((c, (field.eval(&c) - p).norm()))
+        };
+        let first = previous.map(|k| (k, foot(k, seeds[k])));
+        // no face whose surface lies farther than that foot can be the nearest: skipped
+        // (a foot may lie up to 1e-6 of the domain beyond it, on the extrapolation, hence
+        // the margin), which spares a many-sided hole a grid search on every far face
+        let bound = match first {
+            Some((_, Some((_, dist)))) => dist + 1e-6 * size,
+            _ => f64::INFINITY,
+        };
+        // the nearest face around
+        let mut best: Option<(f64, usize, [f64; 2])> = None;
+        for k in 0..faces.len() {
+            let found = match first {
+                Some((kp, found)) if kp == k => found,
+                _ => {
+                    let far = b.faces[faces[k]].surface.as_ref().and_then(|fs| fs.distance_bound(p));
+                    if far.is_some_and(|x| x > bound) {
+                        continue;
+                    }
+                    foot(k, seeds[k])
+                }
+            };
+            let Some((c, dist)) = found else { continue };
             seeds[k] = Some(c);
-            let dist = (field.eval(&c) - p).norm();
             if best.is_none_or(|x| dist < x.0) {
                 best = Some((dist, k, c));
             }
         }
+        previous = best.map(|x| x.1);
         let Some((dist, k, c)) = best else {
             out.gap = f64::NAN;
             continue;

@@ -176,6 +176,45 @@ impl NurbsSurface {
         self.rational
     }
 
+    /// The box of the control points `[lo, hi]`: it holds the surface on its knot ranges
+    /// (a B-spline with positive weights is a convex combination of its control points).
+    pub fn control_box(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+        let mut hi = -lo;
+        for c in &self.cw {
+            let p = Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3]);
+            // the points are finite (checked by `new`); a NaN would still propagate
+            use crate::num::{max_nan, min_nan};
+            lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
+            hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
+        }
+        (lo, hi)
+    }
+
+    /// `Σ_a Σ_b N_a M_b P_ab` over the homogeneous net `[w x, w y, w z, w]` for the basis
+    /// rows `N` (on `u` span `su`) and `M` (on `v` span `sv`): the one sum of every
+    /// evaluation, so that its order (and so its bits) is the same everywhere.
+    fn net_sum(&self, (su, rowu): (usize, &[f64]), (sv, rowv): (usize, &[f64])) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        for (a, nu) in rowu.iter().enumerate() {
+            if *nu == 0.0 {
+                continue;
+            }
+            let base = (su - self.pu + a) * self.nv + sv - self.pv;
+            let mut inner = [0.0; 4];
+            for (b, mv) in rowv.iter().enumerate() {
+                let p = &self.cw[base + b];
+                for q in 0..4 {
+                    inner[q] += mv * p[q];
+                }
+            }
+            for q in 0..4 {
+                acc[q] += nu * inner[q];
+            }
+        }
+        acc
+    }
+
     /// `S` on the grid `us × vs` (row-major in `u`): each parameter's basis values once,
     /// then per point the sums [`Field::eval`] makes, in the same order (the same bits).
     pub fn grid_values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
@@ -188,23 +227,7 @@ impl NurbsSurface {
         for &u in us {
             let (su, rowu) = basis(&self.ku, self.nu, self.pu, u);
             for (sv, rowv) in &bv {
-                let mut acc = [0.0; 4];
-                for (a, nu) in rowu.iter().enumerate() {
-                    if *nu == 0.0 {
-                        continue;
-                    }
-                    let base = (su - self.pu + a) * self.nv + sv - self.pv;
-                    let mut inner = [0.0; 4];
-                    for (b, mv) in rowv.iter().enumerate() {
-                        let p = &self.cw[base + b];
-                        for q in 0..4 {
-                            inner[q] += mv * p[q];
-                        }
-                    }
-                    for q in 0..4 {
-                        acc[q] += nu * inner[q];
-                    }
-                }
+                let acc = self.net_sum((su, &rowu), (*sv, rowv));
                 // as `quotient` divides a constant jet: times the reciprocal of `w`
                 let s = 1.0 / acc[3];
                 out.push(Vec3::new(acc[0] * s, acc[1] * s, acc[2] * s));
@@ -230,23 +253,7 @@ impl Field for NurbsSurface {
         for (i, rowu) in bu.iter().enumerate() {
             for (k, rowv) in bv.iter().enumerate() {
                 let idx = shape.index([i, k, 0]);
-                let mut acc = [0.0; 4];
-                for (a, nu) in rowu.iter().enumerate() {
-                    if *nu == 0.0 {
-                        continue;
-                    }
-                    let base = (su - self.pu + a) * self.nv + sv - self.pv;
-                    let mut inner = [0.0; 4];
-                    for (b, mv) in rowv.iter().enumerate() {
-                        let p = &self.cw[base + b];
-                        for q in 0..4 {
-                            inner[q] += mv * p[q];
-                        }
-                    }
-                    for q in 0..4 {
-                        acc[q] += nu * inner[q];
-                    }
-                }
+                let acc = self.net_sum((su, rowu), (sv, rowv));
                 for q in 0..4 {
                     c[q][idx] = acc[q];
                 }
