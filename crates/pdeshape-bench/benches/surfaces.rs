@@ -287,7 +287,9 @@ fn step_holes(c: &mut Criterion) {
     let limits = pdeshape_core::limits::Limits::default();
     let mut g = c.benchmark_group("step fill-holes");
     g.sample_size(10);
-    for (model, edges) in [("cylinder-open", 1), ("rounded-box-corners", 3), ("loft-open", 1), ("touching-parts", 2)] {
+    for (model, edges) in
+        [("cylinder-open", 1), ("rounded-box-corners", 3), ("loft-open", 1), ("touching-parts", 2), ("loft-twelve", 12)]
+    {
         let bytes = std::fs::read(dir.join(format!("{model}.step"))).expect("the model");
         for order in [4, 6] {
             let opts = FillHolesOptions { order, holes: Some(vec![1]), ..Default::default() };

@@ -44,6 +44,8 @@ CASES = [
     ("cylinder-open", 1, (0, 0, 2)),
     ("rounded-box-corners", 1, (0, 0, 0)),
     ("loft-open", 1, (0, 0, 2)),
+    # twelve edges, each on its own B-spline face
+    ("loft-twelve", 1, (0, 0, 2)),
     # the lens between the touching parts on the side x < 0 (one edge of each part)
     ("touching-parts", 2, (-1, 0, 1)),
 ]

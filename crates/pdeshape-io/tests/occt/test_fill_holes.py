@@ -52,7 +52,7 @@ make_models = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(make_models)
 
 # name: number of holes
-MODELS = {"cylinder-open": 1, "rounded-box-corners": 8, "loft-open": 1, "tube-windows": 4, "touching-parts": 2}
+MODELS = {"cylinder-open": 1, "rounded-box-corners": 8, "loft-open": 1, "loft-twelve": 1, "tube-windows": 4, "touching-parts": 2}
 
 
 @pytest.fixture(scope="module")

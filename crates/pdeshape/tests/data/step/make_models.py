@@ -9,6 +9,9 @@
   its eight spherical corner faces: eight three-sided holes between cylindrical faces.
 - loft-open.step: a loft through a circle, an ellipse and a smaller circle (B-spline
   faces) without its top: one hole bounded by one closed edge on a B-spline face.
+- loft-twelve.step: a loft through three circles (radius 1 at z = 0; 1.3, its centre moved
+  by (0.2, 0.1), at z = 1; 0.7 at z = 2), each cut into twelve arcs, without its top: one
+  hole of twelve edges, each on its own B-spline face, the faces meeting G1 at its corners.
 - tube-windows.step: a B-spline tube (a loft's lateral face alone: a circle, an ellipse, a
   smaller circle) with two windows cut through its wall by boxes: four holes on its one
   face — the two open ends (one closed edge each) and the two windows (four edges each,
@@ -23,6 +26,8 @@
 Made by this project with OpenCASCADE; no third-party content.
 """
 
+import math
+
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut
 from OCP.BRep import BRep_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Surface
@@ -34,6 +39,7 @@ from OCP.BRepBuilderAPI import (
 )
 from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
 from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+from OCP.GC import GC_MakeArcOfCircle
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GeomAbs import GeomAbs_Plane, GeomAbs_Sphere
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
@@ -96,6 +102,20 @@ def main():
     loft.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 2), gp_Dir(0, 0, 1)), 0.7)))
     loft.Build()
     write(shell_without(loft.Shape(), top_plane(2.0)), "loft-open.step")
+
+    def arcs(circle, n=12):
+        w = BRepBuilderAPI_MakeWire()
+        for k in range(n):
+            a0, a1 = 2 * math.pi * k / n, 2 * math.pi * (k + 1) / n
+            w.Add(BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(circle, a0, a1, True).Value()).Edge())
+        return w.Wire()
+
+    twelve = BRepOffsetAPI_ThruSections(True, False)
+    twelve.AddWire(arcs(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0)))
+    twelve.AddWire(arcs(gp_Circ(gp_Ax2(gp_Pnt(0.2, 0.1, 1), gp_Dir(0, 0, 1)), 1.3)))
+    twelve.AddWire(arcs(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 2), gp_Dir(0, 0, 1)), 0.7)))
+    twelve.Build()
+    write(shell_without(twelve.Shape(), top_plane(2.0)), "loft-twelve.step")
 
     tube = BRepOffsetAPI_ThruSections(False, False)
     tube.AddWire(wire(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0)))
