@@ -14,6 +14,7 @@ around) and the difference of their normal curvatures across the edge. Times: me
 5, one thread.
 
     python crates/pdeshape-io/bench/occt_fill_holes.py     # needs cadquery-ocp and a release build
+    python crates/pdeshape-io/bench/occt_fill_holes.py loft-twelve --order 4   # named holes, one order
 """
 
 import math
@@ -44,11 +45,12 @@ CASES = [
     ("cylinder-open", 1, (0, 0, 2)),
     ("rounded-box-corners", 1, (0, 0, 0)),
     ("loft-open", 1, (0, 0, 2)),
-    # twelve edges, each on its own B-spline face
-    ("loft-twelve", 1, (0, 0, 2)),
     # the lens between the touching parts on the side x < 0 (one edge of each part)
     ("touching-parts", 2, (-1, 0, 1)),
 ]
+# run only when named: twelve edges, each on its own B-spline face (OpenCASCADE's measure
+# of pdeshape's order-6 face there did not finish in 10 minutes)
+NAMED_ONLY = [("loft-twelve", 1, (0, 0, 2))]
 PER_EDGE = 200
 
 
@@ -129,7 +131,14 @@ def main():
     print("| hole | method | time (ms, median of 5) | gap | G1 error (rad) | curvature difference |")
     print("|---|---|---|---|---|---|")
     tmp = Path(tempfile.mkdtemp())
-    for name, k, near in CASES:
+    args = sys.argv[1:]
+    orders = (4, 6)
+    if "--order" in args:
+        i = args.index("--order")
+        orders = (int(args[i + 1]),)
+        del args[i : i + 2]
+    cases = [c for c in CASES + NAMED_ONLY if c[0] in args] if args else CASES
+    for name, k, near in cases:
         model = DATA / f"{name}.step"
         edges = hole_edges(read(model), near)
         for label, order in [("MakeFilling G1", GeomAbs_G1), ("MakeFilling C1 (its G2)", GeomAbs_C1)]:
@@ -143,7 +152,7 @@ def main():
                 continue
             gap, g1, kgap = measure([(e, f, face) for e, f in edges])
             print(f"| {name} | {label} | {statistics.median(times):.1f} | {gap:.1e} | {g1:.1e} | {kgap:.1e} |")
-        for order in (4, 6):
+        for order in orders:
             out = tmp / f"{name}-{order}.step"
             times = []
             for _ in range(5):
