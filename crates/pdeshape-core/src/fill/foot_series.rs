@@ -266,6 +266,34 @@ mod tests {
     /// The helix on a cylinder of radius 2 of the foot curve's own test, whose foot is
     /// `c(τ) = (τ², τ³)` in closed form: the series' values and derivatives to the fourth
     /// against it at points between the nodes, and its measured error.
+    /// The derivative series kept per piece (orders ≤ `DERIVED`) and those derived at the
+    /// call (above) give the bits of deriving anew from the coefficients, orders 0 to 14.
+    #[test]
+    fn kept_derivative_series_are_those_derived_anew() {
+        let host: FieldRef =
+            Arc::new(ExprField::parse(["2*cos(u)", "2*sin(u)", "v"], &["u", "v", "t"], &|_| None).unwrap());
+        let curve = Arc::new(ExprField::parse(["2*cos(s*s)", "2*sin(s*s)", "s*s*s"], &["s"], &|_| None).unwrap());
+        let f = FootCurve::new(host, curve, (0.5, 1.5), [0.25, 0.1], 0.0).unwrap();
+        let s = FootSeries::new(&f, (0.5, 1.5), 1e-13).unwrap();
+        for tau in [0.5, 0.77, 1.2, 1.5] {
+            let d = s.derivatives(tau, 14);
+            let i = s.breaks[1..s.breaks.len() - 1].partition_point(|&b| b <= tau);
+            let (a, b) = (s.breaks[i], s.breaks[i + 1]);
+            let (x, scale) = ((2.0 * tau - a - b) / (b - a), 2.0 / (b - a));
+            for q in 0..2 {
+                let mut c = s.derived[i][q][0].to_vec();
+                let mut f = 1.0;
+                for (m, dm) in d.iter().enumerate() {
+                    if m > 0 {
+                        c = derivative(&c);
+                        f *= scale;
+                    }
+                    assert_eq!((clenshaw(&c, x) * f).to_bits(), dm[q].to_bits(), "order {m} at {tau}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn a_helix_foot_against_the_closed_form() {
         let host: FieldRef =
