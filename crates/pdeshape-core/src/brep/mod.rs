@@ -51,42 +51,38 @@ impl FaceSurface {
 
     /// Parameters of a point near the foot of `p` (exact for analytic surfaces; for a
     /// B-spline surface the nearest of a grid of samples, for Newton's method to finish).
+    /// For many feet on one face, make the [`start_grid`](Self::start_grid) once.
     pub fn invert_near(&self, p: Vec3) -> [f64; 2] {
+        self.start_grid().start(p)
+    }
+
+    /// Where Newton's method for feet on this face starts: for a B-spline surface its
+    /// values on a 49 × 49 grid over its knot ranges.
+    pub fn start_grid(&self) -> StartGrid {
         match self {
-            FaceSurface::Analytic(a) => a.invert(p, None),
+            FaceSurface::Analytic(a) => StartGrid::Analytic(*a),
             FaceSurface::Nurbs(n) => {
                 let ((u0, u1), (v0, v1)) = n.domain();
                 let k = 48;
                 let us: Vec<f64> = (0..=k).map(|i| u0 + (u1 - u0) * i as f64 / k as f64).collect();
                 let vs: Vec<f64> = (0..=k).map(|j| v0 + (v1 - v0) * j as f64 / k as f64).collect();
-                let mut best = (f64::INFINITY, [u0, v0]);
-                for (x, idx) in n.grid_values(&us, &vs).into_iter().zip(0..) {
-                    let d = (x - p).norm();
-                    if d < best.0 {
-                        best = (d, [us[idx / (k + 1)], vs[idx % (k + 1)]]);
-                    }
-                }
-                best.1
+                StartGrid::Grid { values: n.grid_values(&us, &vs), us, vs }
             }
         }
     }
 
-    /// A lower bound of the distance from `p` to the surface on its domain, or `None` where
-    /// none is known (analytic surfaces are unbounded): for a B-spline surface the distance
-    /// to the box of its control points, which holds it.
-    pub fn distance_bound(&self, p: Vec3) -> Option<f64> {
+    /// A box `[lo, hi]` that holds the surface on its domain, or `None` where none is known
+    /// (analytic surfaces are unbounded): for a B-spline surface its control points' box
+    /// (with positive weights it is a convex combination of them).
+    pub fn bounding_box(&self) -> Option<(Vec3, Vec3)> {
         let FaceSurface::Nurbs(n) = self else { return None };
-        let (lo, hi) = n.control_box();
-        let out = |x: f64, a: f64, b: f64| {
-            if x < a {
-                a - x
-            } else if x > b {
-                x - b
-            } else {
-                0.0
-            }
-        };
-        Some(Vec3::new(out(p.x, lo.x, hi.x), out(p.y, lo.y, hi.y), out(p.z, lo.z, hi.z)).norm())
+        Some(n.control_box())
+    }
+
+    /// A lower bound of the distance from `p` to the surface on its domain, or `None` where
+    /// none is known: the distance to its [`bounding_box`](Self::bounding_box).
+    pub fn distance_bound(&self, p: Vec3) -> Option<f64> {
+        self.bounding_box().map(|b| box_distance(b, p))
     }
 
     /// Whether `c` lies in the surface's parameter domain (to 1e-6 of its extent, where
@@ -136,6 +132,57 @@ impl FaceSurface {
     pub fn normal(&self, c: [f64; 2]) -> Option<Vec3> {
         let j = self.field().jet(&[c[0], c[1], 0.0], JetShape::new(&[1, 1]));
         j.derivative([1, 0, 0]).cross(j.derivative([0, 1, 0])).normalized()
+    }
+}
+
+/// The distance from `p` to the box `[lo, hi]` (0 inside).
+pub fn box_distance((lo, hi): (Vec3, Vec3), p: Vec3) -> f64 {
+    let out = |x: f64, a: f64, b: f64| {
+        if x < a {
+            a - x
+        } else if x > b {
+            x - b
+        } else {
+            0.0
+        }
+    };
+    Vec3::new(out(p.x, lo.x, hi.x), out(p.y, lo.y, hi.y), out(p.z, lo.z, hi.z)).norm()
+}
+
+/// Where Newton's method for feet on a face starts ([`FaceSurface::start_grid`]), made once
+/// for many feet.
+#[derive(Clone, Debug)]
+pub enum StartGrid {
+    /// An analytic surface: inverted in closed form.
+    Analytic(AnalyticSurface),
+    /// A B-spline surface's values on the grid `us × vs`, row-major in `u`.
+    Grid {
+        /// `S(us[i], vs[j])` at `i · vs.len() + j`.
+        values: Vec<Vec3>,
+        /// The grid's `u`.
+        us: Vec<f64>,
+        /// The grid's `v`.
+        vs: Vec<f64>,
+    },
+}
+
+impl StartGrid {
+    /// Parameters of a point near the foot of `p`: exact on an analytic surface, the
+    /// nearest grid point (the first of equals) on a B-spline surface.
+    pub fn start(&self, p: Vec3) -> [f64; 2] {
+        match self {
+            StartGrid::Analytic(a) => a.invert(p, None),
+            StartGrid::Grid { values, us, vs } => {
+                let mut best = (f64::INFINITY, [us[0], vs[0]]);
+                for (x, idx) in values.iter().zip(0..) {
+                    let d = (*x - p).norm();
+                    if d < best.0 {
+                        best = (d, [us[idx / vs.len()], vs[idx % vs.len()]]);
+                    }
+                }
+                best.1
+            }
+        }
     }
 }
 
