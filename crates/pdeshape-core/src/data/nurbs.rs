@@ -288,6 +288,28 @@ impl NurbsCurve {
     pub fn domain(&self) -> (f64, f64) {
         (self.knots[self.p], self.knots[self.cw.len()])
     }
+
+    /// `C` at each of `ts`: per parameter its basis values and the sum [`Field::eval`]
+    /// makes, in the same order (the same bits), without a jet.
+    pub fn values(&self, ts: &[f64]) -> Vec<Vec3> {
+        let n = self.cw.len();
+        ts.iter()
+            .map(|&t| {
+                let s = find_span(&self.knots, n, self.p, t);
+                let row = basis_taylor(&self.knots, self.p, s, t, 0).swap_remove(0);
+                let mut acc = [0.0; 4];
+                for (a, nb) in row.iter().enumerate() {
+                    let p = &self.cw[s - self.p + a];
+                    for q in 0..4 {
+                        acc[q] += nb * p[q];
+                    }
+                }
+                // as `quotient` divides a constant jet: times the reciprocal of `w`
+                let r = 1.0 / acc[3];
+                Vec3::new(acc[0] * r, acc[1] * r, acc[2] * r)
+            })
+            .collect()
+    }
 }
 
 impl Field for NurbsCurve {
@@ -322,6 +344,30 @@ impl Field for NurbsCurve {
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_1_SQRT_2;
+
+    /// A curve's values at many parameters are `eval`'s, bit for bit: degree 5 with a
+    /// double interior knot, rational and not, at knots, ends and points between. It fails
+    /// with `x / w` in place of `x · (1/w)`.
+    #[test]
+    fn curve_values_are_eval_bit_for_bit() {
+        let p = 5;
+        let mut k = vec![-0.5; p + 1];
+        k.extend([0.1, 0.3, 0.3, 0.8]);
+        k.extend(vec![2.0; p + 1]);
+        let n = k.len() - p - 1;
+        let pts: Vec<Vec3> =
+            (0..n).map(|i| Vec3::new(i as f64 * 0.7, (1.1 * i as f64).sin(), 0.3 * (i * i) as f64 - 0.9)).collect();
+        let weights: Vec<f64> = (0..n).map(|i| 0.6 + 0.37 * ((i * 5 % 7) as f64)).collect();
+        let ts: Vec<f64> = (0..=97).map(|i| -0.5 + 2.5 * i as f64 / 97.0).chain([0.3, 0.1 - 1e-14]).collect();
+        for w in [Some(&weights[..]), None] {
+            let c = NurbsCurve::new(p, k.clone(), &pts, w).unwrap();
+            for (x, t) in c.values(&ts).into_iter().zip(&ts) {
+                let e = c.eval(&[*t]);
+                let bits = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                assert_eq!(bits(x), bits(e), "at {t}: {x} vs {e}");
+            }
+        }
+    }
 
     /// The grid evaluation is `eval` at every grid point, bit for bit: a rational surface of
     /// degrees (13, 3) with interior knots (a double one too), and a polynomial one, on

@@ -611,7 +611,8 @@ impl<'g> Reader<'g> {
                 if closed {
                     if same_sense { (a, b) } else { (b, a) }
                 } else {
-                    (invert_curve(n.as_ref(), p0, (a, b)), invert_curve(n.as_ref(), p1, (a, b)))
+                    let [t0, t1] = invert_curve(n.as_ref(), [p0, p1], (a, b));
+                    (t0, t1)
                 }
             }
         };
@@ -885,27 +886,37 @@ impl<'g> Reader<'g> {
     }
 }
 
-/// The parameter of the point of `c` nearest `p`: the best of 256 samples, then Newton.
-fn invert_curve(c: &NurbsCurve, p: Vec3, (a, b): (f64, f64)) -> f64 {
+/// The parameters of the points of `c` nearest `ps`: each the best of 257 samples (the
+/// first of equals; the samples evaluated once for all points), then Newton's method.
+fn invert_curve<const N: usize>(c: &NurbsCurve, ps: [Vec3; N], (a, b): (f64, f64)) -> [f64; N] {
     let n = 256;
-    let mut t = (0..=n)
-        .map(|i| a + (b - a) * i as f64 / n as f64)
-        .min_by(|x, y| (c.eval(&[*x]) - p).norm().total_cmp(&(c.eval(&[*y]) - p).norm()))
-        .unwrap_or(a);
-    for _ in 0..30 {
-        let mut d = [Vec3::ZERO; 3];
-        c.derivatives_in(&[t], 0, &mut d);
-        let r = d[0] - p;
-        let g = r.dot(d[1]);
-        let h = d[1].dot(d[1]) + r.dot(d[2]);
-        if h.is_nan() || h <= 0.0 {
-            break;
+    let ts: Vec<f64> = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
+    let values = c.values(&ts);
+    ps.map(|p| {
+        let mut best = (f64::INFINITY, a);
+        for (x, t) in values.iter().zip(&ts) {
+            let d = (*x - p).norm();
+            // NaN never wins, as with `total_cmp`'s order of finite distances
+            if d < best.0 {
+                best = (d, *t);
+            }
         }
-        let step = g / h;
-        t = (t - step).clamp(a, b);
-        if step.abs() <= 1e-15 * (1.0 + t.abs()) {
-            break;
+        let mut t = best.1;
+        for _ in 0..30 {
+            let mut d = [Vec3::ZERO; 3];
+            c.derivatives_in(&[t], 0, &mut d);
+            let r = d[0] - p;
+            let g = r.dot(d[1]);
+            let h = d[1].dot(d[1]) + r.dot(d[2]);
+            if h.is_nan() || h <= 0.0 {
+                break;
+            }
+            let step = g / h;
+            t = (t - step).clamp(a, b);
+            if step.abs() <= 1e-15 * (1.0 + t.abs()) {
+                break;
+            }
         }
-    }
-    t
+        t
+    })
 }
