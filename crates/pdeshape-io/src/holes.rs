@@ -280,26 +280,36 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
             Some((c, (field.eval(&c) - p).norm()))
         };
         let first = previous.map(|k| (k, foot(k, seeds[k], &mut grids[k])));
-        // no face whose surface lies farther than that foot can be the nearest: skipped
-        // (a foot may lie up to 1e-6 of the domain beyond it, on the extrapolation, hence
-        // the margin), which spares a many-sided hole a grid search on every far face
-        let bound = match first {
-            Some((_, Some((_, dist)))) => dist + 1e-6 * size,
-            _ => f64::INFINITY,
-        };
-        // the nearest face around
+        // branch and bound: no face whose surface lies farther than the nearest foot found
+        // so far can be the nearest, so the faces are tried nearest box first and skipped
+        // once their box, or their start grid less its slack, lies farther than that foot
+        // (plus a margin: a foot may lie up to 1e-6 of the domain beyond it, on the
+        // extrapolation; the margin is far above the grid's round-off). A many-sided hole
+        // is spared a search on every far face, also where the samples pass from one face
+        // to the next and the last face's foot leaves it.
+        let margin = 1e-6 * size;
         let mut best: Option<(f64, usize, [f64; 2])> = None;
-        for k in 0..faces.len() {
-            let found = match first {
-                Some((kp, found)) if kp == k => found,
-                _ => {
-                    if boxes[k].is_some_and(|x| box_distance(x, p) > bound) {
-                        continue;
-                    }
-                    foot(k, seeds[k], &mut grids[k])
-                }
-            };
-            let Some((c, dist)) = found else { continue };
+        if let Some((k, Some((c, dist)))) = first {
+            seeds[k] = Some(c);
+            best = Some((dist, k, c));
+        }
+        let mut others: Vec<(f64, usize)> = (0..faces.len())
+            .filter(|k| first.is_none_or(|(kp, _)| kp != *k))
+            .map(|k| (boxes[k].map_or(0.0, |x| box_distance(x, p)), k))
+            .collect();
+        others.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (near, k) in others {
+            let bound = best.map_or(f64::INFINITY, |x| x.0 + margin);
+            // (a NaN is never skipped)
+            if near > bound {
+                continue;
+            }
+            if let Some(fs) = &b.faces[faces[k]].surface
+                && grids[k].get_or_insert_with(|| fs.start_grid()).distance_bound(p).is_some_and(|x| x > bound)
+            {
+                continue;
+            }
+            let Some((c, dist)) = foot(k, seeds[k], &mut grids[k]) else { continue };
             seeds[k] = Some(c);
             if best.is_none_or(|x| dist < x.0) {
                 best = Some((dist, k, c));

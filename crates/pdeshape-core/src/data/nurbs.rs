@@ -191,6 +191,39 @@ impl NurbsSurface {
         (lo, hi)
     }
 
+    /// Bounds `[L_u, L_v]` of `|∂S/∂u|` and `|∂S/∂v|` over the knot ranges, or `None` for a
+    /// rational surface. `∂S/∂u` is the B-spline of degree `(p_u − 1, p_v)` with control
+    /// points `Q_ij = p_u (P_{i+1,j} − P_ij) / (u_{i+p_u+1} − u_{i+1})` (terms over an empty
+    /// knot interval vanish), a convex combination of them: `|∂S/∂u| ≤ max |Q_ij|`
+    /// (The NURBS Book, eq. 3.17); likewise in `v`. At the ends it is attained.
+    pub fn derivative_bounds(&self) -> Option<[f64; 2]> {
+        if self.rational {
+            return None;
+        }
+        let point = |i: usize, j: usize| {
+            let c = &self.cw[i * self.nv + j];
+            Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3])
+        };
+        let mut l = [0.0f64; 2];
+        for i in 0..self.nu {
+            for j in 0..self.nv {
+                if i + 1 < self.nu {
+                    let den = self.ku[i + self.pu + 1] - self.ku[i + 1];
+                    if den > 0.0 {
+                        l[0] = crate::num::max_nan(l[0], self.pu as f64 * (point(i + 1, j) - point(i, j)).norm() / den);
+                    }
+                }
+                if j + 1 < self.nv {
+                    let den = self.kv[j + self.pv + 1] - self.kv[j + 1];
+                    if den > 0.0 {
+                        l[1] = crate::num::max_nan(l[1], self.pv as f64 * (point(i, j + 1) - point(i, j)).norm() / den);
+                    }
+                }
+            }
+        }
+        Some(l)
+    }
+
     /// `Σ_a Σ_b N_a M_b P_ab` over the homogeneous net `[w x, w y, w z, w]` for the basis
     /// rows `N` (on `u` span `su`) and `M` (on `v` span `sv`): the one sum of every
     /// evaluation, so that its order (and so its bits) is the same everywhere.
