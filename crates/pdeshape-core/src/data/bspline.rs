@@ -205,10 +205,24 @@ pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd
     let u = knots;
     // the tables of A2.3 flat and on the stack up to degree 7 (cubics in the mesh collars,
     // called for every jet): `ndu[i][j]` at `i·(p+1) + j`, `a[s][j]` at `s·(p+1) + j`
+    // (stack arrays and slices of them, not `SmallVec`s: each of their indexings asks
+    // whether the data are inline, 5 % of a twelve-edge hole's fill)
     let w = p + 1;
-    let mut ndu: smallvec::SmallVec<[f64; 64]> = smallvec::smallvec![0.0; w * w];
-    let mut left: smallvec::SmallVec<[f64; 8]> = smallvec::smallvec![0.0; w];
-    let mut right: smallvec::SmallVec<[f64; 8]> = smallvec::smallvec![0.0; w];
+    let (mut ndu_stack, mut lr_stack, mut a_stack) = ([0.0; 64], [0.0; 16], [0.0; 16]);
+    let (mut ndu_heap, mut lr_heap, mut a_heap) = (Vec::new(), Vec::new(), Vec::new());
+    let ndu: &mut [f64] = if w * w <= 64 {
+        &mut ndu_stack[..w * w]
+    } else {
+        ndu_heap.resize(w * w, 0.0);
+        &mut ndu_heap
+    };
+    let lr: &mut [f64] = if 2 * w <= 16 {
+        &mut lr_stack[..2 * w]
+    } else {
+        lr_heap.resize(2 * w, 0.0);
+        &mut lr_heap
+    };
+    let (left, right) = lr.split_at_mut(w);
     ndu[0] = 1.0;
     for j in 1..=p {
         left[j] = x - u[span + 1 - j];
@@ -228,7 +242,12 @@ pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd
     for (j, d) in ders[0].iter_mut().enumerate() {
         *d = ndu(j, p);
     }
-    let mut a: smallvec::SmallVec<[f64; 16]> = smallvec::smallvec![0.0; 2 * w];
+    let a: &mut [f64] = if 2 * w <= 16 {
+        &mut a_stack[..2 * w]
+    } else {
+        a_heap.resize(2 * w, 0.0);
+        &mut a_heap
+    };
     // `r` indexes A2.3's tables as well as `ders`
     #[allow(clippy::needless_range_loop)]
     for r in 0..=p {

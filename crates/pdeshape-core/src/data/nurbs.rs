@@ -87,19 +87,18 @@ fn find_span(knots: &[f64], n: usize, p: usize, x: f64) -> usize {
 
 /// Basis derivatives `dᵏNᵣ/dxᵏ / k!` for `k ≤ nd` (zero above the degree), at span `s`.
 fn basis_taylor(knots: &[f64], p: usize, s: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
-    let d = super::basis_derivatives(knots, p, s, x, nd);
-    let mut out = vec![vec![0.0; p + 1]; nd + 1];
+    // the derivatives' own rows divided in place (the same quotients as into new rows)
+    let mut out = super::basis_derivatives(knots, p, s, x, nd);
     let mut fact = 1.0;
     for (k, row) in out.iter_mut().enumerate() {
         if k > 0 {
             fact *= k as f64;
         }
-        if let Some(dk) = d.get(k) {
-            for (o, v) in row.iter_mut().zip(dk) {
-                *o = v / fact;
-            }
+        for o in row.iter_mut() {
+            *o /= fact;
         }
     }
+    out.resize(nd + 1, vec![0.0; p + 1]);
     out
 }
 
@@ -233,16 +232,36 @@ impl NurbsSurface {
             if *nu == 0.0 {
                 continue;
             }
-            let base = (su - self.pu + a) * self.nv + sv - self.pv;
-            let mut inner = [0.0; 4];
-            for (b, mv) in rowv.iter().enumerate() {
-                let p = &self.cw[base + b];
-                for q in 0..4 {
-                    inner[q] += mv * p[q];
-                }
-            }
+            let inner = self.inner_sum(su, a, (sv, rowv));
             for q in 0..4 {
                 acc[q] += nu * inner[q];
+            }
+        }
+        acc
+    }
+
+    /// `Σ_b M_b P_ab` for the `a`-th control row of `u` span `su`: `net_sum`'s inner sum.
+    fn inner_sum(&self, su: usize, a: usize, (sv, rowv): (usize, &[f64])) -> [f64; 4] {
+        let base = (su - self.pu + a) * self.nv + sv - self.pv;
+        let mut inner = [0.0; 4];
+        for (b, mv) in rowv.iter().enumerate() {
+            let p = &self.cw[base + b];
+            for q in 0..4 {
+                inner[q] += mv * p[q];
+            }
+        }
+        inner
+    }
+
+    /// `Σ_a N_a inner_a`, skipping `N_a = 0` as `net_sum` does: its outer sum.
+    fn outer_sum(rowu: &[f64], inner: &[[f64; 4]]) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        for (nu, x) in rowu.iter().zip(inner) {
+            if *nu == 0.0 {
+                continue;
+            }
+            for q in 0..4 {
+                acc[q] += nu * x[q];
             }
         }
         acc
@@ -283,10 +302,16 @@ impl Field for NurbsSurface {
         let bu = basis_taylor(&self.ku, self.pu, su, u, ou);
         let bv = basis_taylor(&self.kv, self.pv, sv, v, ov);
         let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
-        for (i, rowu) in bu.iter().enumerate() {
-            for (k, rowv) in bv.iter().enumerate() {
+        // `net_sum`'s inner sums over `v` depend on the `v` row alone: made once per row
+        // and then summed over `u` as `net_sum` does (the same operations, the same bits)
+        let mut inner = vec![[0.0; 4]; self.pu + 1];
+        for (k, rowv) in bv.iter().enumerate() {
+            for (a, x) in inner.iter_mut().enumerate() {
+                *x = self.inner_sum(su, a, (sv, rowv));
+            }
+            for (i, rowu) in bu.iter().enumerate() {
                 let idx = shape.index([i, k, 0]);
-                let acc = self.net_sum((su, rowu), (sv, rowv));
+                let acc = Self::outer_sum(rowu, &inner);
                 for q in 0..4 {
                     c[q][idx] = acc[q];
                 }
