@@ -124,6 +124,9 @@ pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePie
     };
     let host = surface.field();
     let curve = ec.field();
+    // a C¹ face and a C¹ edge curve: the face's frame along the edge has no jump, and no
+    // crease is looked for
+    let smooth_face = surface.is_c1();
     let mut out = EdgePieces { edges: Vec::new(), ranges: Vec::new(), offset: 0.0 };
     for c in 0..cuts {
         let ta = a + (z - a) * c as f64 / cuts as f64;
@@ -139,7 +142,14 @@ pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePie
             None => Arc::new(foot),
         };
         let along = AlongCurve { host: Host::Field(host.clone()), curve: DomainCurve::Field(domain) };
-        out.edges.push(FillEdge { surface: Arc::new(along), s0: 0.0, w: (ta, tb), fullness: 1.0, side: Some(side) });
+        out.edges.push(FillEdge {
+            surface: Arc::new(along),
+            s0: 0.0,
+            w: (ta, tb),
+            fullness: 1.0,
+            side: Some(side),
+            smooth: smooth_face && ec.is_c1(),
+        });
         out.ranges.push((ta, tb));
     }
     Ok(out)

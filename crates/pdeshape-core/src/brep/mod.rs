@@ -74,6 +74,16 @@ impl FaceSurface {
         }
     }
 
+    /// Whether the surface is known to be `C¹` on its domain: analytic surfaces are; a
+    /// B-spline surface when no interior knot has multiplicity of its degree or more and it
+    /// does not close on itself (its seam is not known to be `C¹`).
+    pub fn is_c1(&self) -> bool {
+        match self {
+            FaceSurface::Analytic(_) => true,
+            FaceSurface::Nurbs(n) => n.is_c1() && self.closed() == [false, false],
+        }
+    }
+
     /// A box `[lo, hi]` that holds the surface on its domain, or `None` where none is known
     /// (analytic surfaces are unbounded): for a B-spline surface its control points' box
     /// (with positive weights it is a convex combination of them).
@@ -254,6 +264,15 @@ impl EdgeCurve {
         match self {
             EdgeCurve::Analytic(a) => Arc::new(*a),
             EdgeCurve::Nurbs(n) => n.clone(),
+        }
+    }
+
+    /// Whether the curve is known to be `C¹`: lines, circles and ellipses are; a B-spline
+    /// curve when no interior knot has multiplicity of its degree or more.
+    pub fn is_c1(&self) -> bool {
+        match self {
+            EdgeCurve::Analytic(_) => true,
+            EdgeCurve::Nurbs(n) => n.is_c1(),
         }
     }
 }
@@ -551,6 +570,56 @@ mod tests {
         let r = crate::data::NurbsSurface::new((3, 2), ku, kv, (nu, nv), &pts, Some(&w)).unwrap();
         assert_eq!(r.derivative_bounds(), None);
         assert_eq!(FaceSurface::Nurbs(Arc::new(r)).start_grid().distance_bound(Vec3::ZERO), None);
+    }
+
+    /// Which faces are known `C¹` (and so skip the fills' crease search): a plane; an open
+    /// cubic × quadratic B-spline with a double knot; not with a triple one; not a tube
+    /// closed on itself (a quadratic circle of nine points), however smooth its knots.
+    #[test]
+    fn faces_known_c1() {
+        let plane = AnalyticSurface {
+            kind: AnalyticKind::Plane,
+            frame: Frame::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0), None).unwrap(),
+        };
+        assert!(FaceSurface::Analytic(plane).is_c1());
+        let sheet = |inner: &[f64]| {
+            let ku = [vec![0.0; 4], inner.to_vec(), vec![1.0; 4]].concat();
+            let nu = ku.len() - 4;
+            let pts: Vec<Vec3> =
+                (0..nu * 3).map(|i| Vec3::new((i / 3) as f64, (i % 3) as f64, 0.2 * ((i * 5) % 7) as f64)).collect();
+            let n = crate::data::NurbsSurface::new((3, 2), ku, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], (nu, 3), &pts, None);
+            FaceSurface::Nurbs(Arc::new(n.unwrap()))
+        };
+        assert!(sheet(&[0.4, 0.4]).is_c1());
+        assert!(!sheet(&[0.4, 0.4, 0.4]).is_c1());
+        // a quadratic rational circle (nine points, double knots at the quarters) swept
+        // along z: C¹ as a circle, but its knots say C0 at the quarters; the closed tube
+        // fails on closing alone with the knots made single
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let ring = [
+            (1.0, 0.0),
+            (1.0, 1.0),
+            (0.0, 1.0),
+            (-1.0, 1.0),
+            (-1.0, 0.0),
+            (-1.0, -1.0),
+            (0.0, -1.0),
+            (1.0, -1.0),
+            (1.0, 0.0),
+        ];
+        let pts: Vec<Vec3> = ring.iter().flat_map(|&(x, y)| [0.0, 1.0].map(|z| Vec3::new(x, y, z))).collect();
+        let w: Vec<f64> = (0..18).map(|i| if (i / 2) % 2 == 1 { r } else { 1.0 }).collect();
+        let ku = vec![0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0];
+        let tube =
+            crate::data::NurbsSurface::new((2, 1), ku, vec![0.0, 0.0, 1.0, 1.0], (9, 2), &pts, Some(&w)).unwrap();
+        let tube = FaceSurface::Nurbs(Arc::new(tube));
+        assert_eq!(tube.closed(), [true, false]);
+        assert!(!tube.is_c1());
+        let ku = vec![0.0, 0.0, 0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 1.0, 1.0, 1.0];
+        let smooth_knots = crate::data::NurbsSurface::new((2, 1), ku, vec![0.0, 0.0, 1.0, 1.0], (9, 2), &pts, Some(&w));
+        let smooth_knots = FaceSurface::Nurbs(Arc::new(smooth_knots.unwrap()));
+        assert_eq!(smooth_knots.closed(), [true, false]);
+        assert!(!smooth_knots.is_c1());
     }
 
     /// Removing the bottom disc leaves two holes, the rims (the top one and the bottom

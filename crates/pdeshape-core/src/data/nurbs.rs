@@ -102,6 +102,15 @@ fn basis_taylor(knots: &[f64], p: usize, s: usize, x: f64, nd: usize) -> Vec<Vec
     out
 }
 
+/// Whether a B-spline of degree `p` on `knots` (`n` control points) is `C¹` on its knot
+/// range: every knot strictly inside it of multiplicity at most `p − 1` (the basis is
+/// `C^{p−m}` at a knot of multiplicity `m`; weights change nothing).
+fn c1_knots(knots: &[f64], n: usize, p: usize) -> bool {
+    let (lo, hi) = (knots[p], knots[n]);
+    let inner: Vec<f64> = knots.iter().copied().filter(|k| lo < *k && *k < hi).collect();
+    inner.chunk_by(|a, b| a == b).all(|run| run.len() < p)
+}
+
 fn homogeneous(points: &[Vec3], weights: Option<&[f64]>) -> Result<(Vec<[f64; 4]>, bool), NurbsError> {
     if let Some(i) = points.iter().position(|p| !p.is_finite()) {
         return Err(NurbsError::Points(format!("control point {i} is not finite")));
@@ -188,6 +197,12 @@ impl NurbsSurface {
             hi = Vec3::new(max_nan(hi.x, p.x), max_nan(hi.y, p.y), max_nan(hi.z, p.z));
         }
         (lo, hi)
+    }
+
+    /// Whether the surface is `C¹` on its knot ranges (no interior knot of multiplicity `p`
+    /// or more in either direction).
+    pub fn is_c1(&self) -> bool {
+        c1_knots(&self.ku, self.nu, self.pu) && c1_knots(&self.kv, self.nv, self.pv)
     }
 
     /// Bounds `[L_u, L_v]` of `|∂S/∂u|` and `|∂S/∂v|` over the knot ranges, or `None` for a
@@ -347,6 +362,12 @@ impl NurbsCurve {
         (self.knots[self.p], self.knots[self.cw.len()])
     }
 
+    /// Whether the curve is `C¹` on its knot range (no interior knot of multiplicity `p` or
+    /// more).
+    pub fn is_c1(&self) -> bool {
+        c1_knots(&self.knots, self.cw.len(), self.p)
+    }
+
     /// `C` at each of `ts`: per parameter its basis values and the sum [`Field::eval`]
     /// makes, in the same order (the same bits), without a jet.
     pub fn values(&self, ts: &[f64]) -> Vec<Vec3> {
@@ -402,6 +423,36 @@ impl Field for NurbsCurve {
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_1_SQRT_2;
+
+    /// `C¹` by the knots: a double knot in a cubic keeps it, a triple one (or a double one
+    /// in a quadratic) does not; the ends' multiplicities do not count; weights do not
+    /// matter.
+    #[test]
+    fn c1_by_the_knots() {
+        let k = |inner: &[f64], p: usize| [vec![0.0; p + 1], inner.to_vec(), vec![1.0; p + 1]].concat();
+        let curve = |inner: &[f64], p: usize| {
+            let knots = k(inner, p);
+            let n = knots.len() - p - 1;
+            let pts: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f64, (i * i) as f64, 0.0)).collect();
+            NurbsCurve::new(p, knots, &pts, Some(&vec![0.5 + 0.0 * n as f64; n])).unwrap()
+        };
+        assert!(curve(&[], 3).is_c1());
+        assert!(curve(&[0.5, 0.5], 3).is_c1());
+        assert!(!curve(&[0.5, 0.5, 0.5], 3).is_c1());
+        assert!(!curve(&[0.2, 0.5, 0.5], 2).is_c1());
+        assert!(curve(&[0.2, 0.5], 2).is_c1());
+        assert!(!curve(&[0.5], 1).is_c1());
+        let surface = |ku: &[f64], kv: &[f64]| {
+            let (ku, kv) = (k(ku, 3), k(kv, 2));
+            let (nu, nv) = (ku.len() - 4, kv.len() - 3);
+            let pts: Vec<Vec3> =
+                (0..nu * nv).map(|i| Vec3::new((i / nv) as f64, (i % nv) as f64, 0.1 * i as f64)).collect();
+            NurbsSurface::new((3, 2), ku, kv, (nu, nv), &pts, None).unwrap()
+        };
+        assert!(surface(&[0.3, 0.3], &[0.6]).is_c1());
+        assert!(!surface(&[0.3, 0.3, 0.3], &[0.6]).is_c1());
+        assert!(!surface(&[0.3], &[0.6, 0.6]).is_c1());
+    }
 
     /// A curve's values at many parameters are `eval`'s, bit for bit: degree 5 with a
     /// double interior knot, rational and not, at knots, ends and points between. It fails

@@ -82,7 +82,7 @@ mod tests {
 
     fn edge(expr: [&str; 3], w: (f64, f64)) -> FillEdge {
         let f = ExprField::parse(expr, &["s", "w", "t"], &|_| None).unwrap();
-        FillEdge { surface: Arc::new(f), s0: 0.0, w, fullness: 1.0, side: None }
+        FillEdge { surface: Arc::new(f), s0: 0.0, w, fullness: 1.0, side: None, smooth: false }
     }
 
     /// The edge crosses the crease line y = 0.3 of the sheet (x, y, |y − 0.3|) diagonally:

@@ -86,6 +86,10 @@ pub struct FillEdge {
     /// `−S_s`; `None`: towards the loop's centroid (a CAD face's edge knows the side its
     /// material is on, which the centroid does not tell at, e.g., a cylinder's rim).
     pub side: Option<f64>,
+    /// The neighbour is known to be `C¹` around the edge and the edge's curve `C¹` (a CAD
+    /// face and edge whose knots say so): its frame along the edge cannot jump, and no
+    /// crease is looked for. `false` looks (expression surfaces, meshes' collars).
+    pub smooth: bool,
 }
 
 /// Options of a fill.
@@ -647,7 +651,8 @@ impl LoopSetup {
             let mut pieces = Vec::new();
             for (k, e) in edges.iter().enumerate() {
                 let mut start = e.w.0;
-                for (a, b) in crease::creases(e, t) {
+                let found = if e.smooth { Vec::new() } else { crease::creases(e, t) };
+                for (a, b) in found {
                     pieces.push(FillEdge { w: (start, a), ..e.clone() });
                     split.push((k, a));
                     start = b;

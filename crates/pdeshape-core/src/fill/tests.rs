@@ -34,6 +34,7 @@ fn sphere_loop(azimuths: &[f64], theta: f64) -> Vec<FillEdge> {
                 w: (0.0, a.dot(a1).clamp(-1.0, 1.0).acos()),
                 fullness: 1.0,
                 side: None,
+                smooth: false,
             }
         })
         .collect()
@@ -291,7 +292,7 @@ fn ring_fast_path_matches_its_jets() {
 fn creased_square() -> Vec<FillEdge> {
     let edge = |e: [&str; 3]| {
         let f = ExprField::parse(e, &["s", "w", "t"], &|_| None).unwrap();
-        FillEdge { surface: Arc::new(f), s0: 0.0, w: (-1.0, 1.0), fullness: 1.0, side: None }
+        FillEdge { surface: Arc::new(f), s0: 0.0, w: (-1.0, 1.0), fullness: 1.0, side: None, smooth: false }
     };
     vec![
         edge(["w", "-1 + s", "0.5*abs(-1 + s - 0.5*w)"]),
@@ -483,6 +484,7 @@ fn blend_joins_are_where_the_fourth_derivative_jumps() {
             w: (k as f64 * span, (k + 1) as f64 * span),
             fullness: 1.0,
             side: None,
+            smooth: false,
         })
         .collect();
     let cap = Fill::new(&edges, &o).unwrap();

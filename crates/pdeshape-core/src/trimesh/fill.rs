@@ -208,6 +208,8 @@ fn strip_fill(
             w: (w0 + period * k as f64 / 4.0, w0 + period * (k + 1) as f64 / 4.0),
             fullness: 1.0,
             side: Some(1.0),
+            // the collar is not known to be C¹ (its spline may hold C0 knots): looked at
+            smooth: false,
         })
         .collect();
     // every fill of the search from the solves of one (`FillFamily`), its energy on the

@@ -182,7 +182,7 @@ pub(super) fn build_fill(
             Some(x) => ctx.num(x.get_ref(), span(x), &format!("{ek}.fullness"))?,
             None => fullness,
         };
-        list.push(FillEdge { surface, s0, w, fullness: f, side: None });
+        list.push(FillEdge { surface, s0, w, fullness: f, side: None, smooth: false });
     }
     let a = num(&rp.a, "a", 1.0)?;
     let modes = match &rp.modes {
