@@ -238,26 +238,15 @@ impl NurbsSurface {
         Some(l)
     }
 
-    /// `Σ_a Σ_b N_a M_b P_ab` over the homogeneous net `[w x, w y, w z, w]` for the basis
-    /// rows `N` (on `u` span `su`) and `M` (on `v` span `sv`): the one sum of every
-    /// evaluation, so that its order (and so its bits) is the same everywhere.
-    fn net_sum(&self, (su, rowu): (usize, &[f64]), (sv, rowv): (usize, &[f64])) -> [f64; 4] {
-        let mut acc = [0.0; 4];
-        for (a, nu) in rowu.iter().enumerate() {
-            if *nu == 0.0 {
-                continue;
-            }
-            let inner = self.inner_sum(su, a, (sv, rowv));
-            for q in 0..4 {
-                acc[q] += nu * inner[q];
-            }
-        }
-        acc
-    }
-
-    /// `Σ_b M_b P_ab` for the `a`-th control row of `u` span `su`: `net_sum`'s inner sum.
-    fn inner_sum(&self, su: usize, a: usize, (sv, rowv): (usize, &[f64])) -> [f64; 4] {
-        let base = (su - self.pu + a) * self.nv + sv - self.pv;
+    /// Every evaluation sums `Σ_a N_a Σ_b M_b P_ab` over the homogeneous net `[w x, w y,
+    /// w z, w]` for the basis rows `N` (on `u` span `su`) and `M` (on `v` span `sv`) by these
+    /// two sums — the inner over a control row, the outer over the rows, skipping
+    /// `N_a = 0` — so that their order (and so the bits) is the same everywhere.
+    ///
+    /// The inner sum `Σ_b M_b P_rb` over control row `r` (the `a`-th of `u` span `su` is
+    /// `su − p_u + a`).
+    fn inner_sum(&self, r: usize, (sv, rowv): (usize, &[f64])) -> [f64; 4] {
+        let base = r * self.nv + sv - self.pv;
         let mut inner = [0.0; 4];
         for (b, mv) in rowv.iter().enumerate() {
             let p = &self.cw[base + b];
@@ -268,7 +257,7 @@ impl NurbsSurface {
         inner
     }
 
-    /// `Σ_a N_a inner_a`, skipping `N_a = 0` as `net_sum` does: its outer sum.
+    /// The outer sum `Σ_a N_a inner_a`, skipping `N_a = 0`.
     fn outer_sum(rowu: &[f64], inner: &[[f64; 4]]) -> [f64; 4] {
         let mut acc = [0.0; 4];
         for (nu, x) in rowu.iter().zip(inner) {
@@ -283,18 +272,33 @@ impl NurbsSurface {
     }
 
     /// `S` on the grid `us × vs` (row-major in `u`): each parameter's basis values once,
-    /// then per point the sums [`Field::eval`] makes, in the same order (the same bits).
+    /// the inner sums once per control row the grid's `u` spans touch and grid `v`
+    /// (they do not depend on `u`), then per point its outer sum — the operations
+    /// [`Field::eval`] makes, in the same order (the same bits).
     pub fn grid_values(&self, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
         let basis = |k: &[f64], n: usize, p: usize, x: f64| {
             let s = find_span(k, n, p, x);
             (s, basis_taylor(k, p, s, x, 0).swap_remove(0))
         };
         let bv: Vec<(usize, Vec<f64>)> = vs.iter().map(|&v| basis(&self.kv, self.nv, self.pv, v)).collect();
+        let bu: Vec<(usize, Vec<f64>)> = us.iter().map(|&u| basis(&self.ku, self.nu, self.pu, u)).collect();
+        // the inner sums of the control rows the grid touches, `inner[r][j]` for grid v `j`
+        let mut inner: Vec<Vec<[f64; 4]>> = vec![Vec::new(); self.nu];
+        for (su, _) in &bu {
+            for (r, row) in inner.iter_mut().enumerate().take(su + 1).skip(su - self.pu) {
+                if row.is_empty() {
+                    *row = bv.iter().map(|(sv, rowv)| self.inner_sum(r, (*sv, rowv))).collect();
+                }
+            }
+        }
         let mut out = Vec::with_capacity(us.len() * vs.len());
-        for &u in us {
-            let (su, rowu) = basis(&self.ku, self.nu, self.pu, u);
-            for (sv, rowv) in &bv {
-                let acc = self.net_sum((su, &rowu), (*sv, rowv));
+        let mut rows: Vec<[f64; 4]> = vec![[0.0; 4]; self.pu + 1];
+        for (su, rowu) in &bu {
+            for j in 0..bv.len() {
+                for (x, row) in rows.iter_mut().zip(&inner[su - self.pu..]) {
+                    *x = row[j];
+                }
+                let acc = Self::outer_sum(rowu, &rows);
                 // as `quotient` divides a constant jet: times the reciprocal of `w`
                 let s = 1.0 / acc[3];
                 out.push(Vec3::new(acc[0] * s, acc[1] * s, acc[2] * s));
@@ -317,12 +321,12 @@ impl Field for NurbsSurface {
         let bu = basis_taylor(&self.ku, self.pu, su, u, ou);
         let bv = basis_taylor(&self.kv, self.pv, sv, v, ov);
         let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
-        // `net_sum`'s inner sums over `v` depend on the `v` row alone: made once per row
-        // and then summed over `u` as `net_sum` does (the same operations, the same bits)
+        // the inner sums depend on the `v` row alone: made once per row, then summed over
+        // `u` (the same operations as in `grid_values` and `eval`, the same bits)
         let mut inner = vec![[0.0; 4]; self.pu + 1];
         for (k, rowv) in bv.iter().enumerate() {
             for (a, x) in inner.iter_mut().enumerate() {
-                *x = self.inner_sum(su, a, (sv, rowv));
+                *x = self.inner_sum(su - self.pu + a, (sv, rowv));
             }
             for (i, rowu) in bu.iter().enumerate() {
                 let idx = shape.index([i, k, 0]);
