@@ -13,6 +13,7 @@
 //! the host's Taylor expansion at `p(τ₀)` composed with `δp(τ)`: products of series in
 //! `δτ` alone (see [`AlongCurve`]'s `jet`).
 
+use super::series::{binomial, mul_into};
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
 use crate::jet::{Jet, JetShape};
@@ -133,19 +134,13 @@ impl Field for AlongCurve {
             nu1[m] = -c[m + 1][1] / fact;
             nu2[m] = c[m + 1][0] / fact;
         }
-        // the truncated product of two series of length n, into `o`
-        let mul = |a: &[f64], b: &[f64], o: &mut [f64]| {
-            for (l, x) in o.iter_mut().enumerate() {
-                *x = (0..=l).map(|i| a[i] * b[l - i]).sum();
-            }
-        };
         // xᵐ for m = 0 … top, each a series of length n, flat
         let powers = |x: &[f64], top: usize| -> Vec<f64> {
             let mut p = vec![0.0; (top + 1) * n];
             p[0] = 1.0;
             for m in 1..=top {
                 let (done, next) = p.split_at_mut(m * n);
-                mul(&done[(m - 1) * n..], x, &mut next[..n]);
+                mul_into(&done[(m - 1) * n..], x, &mut next[..n]);
             }
             p
         };
@@ -157,17 +152,9 @@ impl Field for AlongCurve {
         let mut q = vec![0.0; n];
         for m in 0..=kw {
             for l in 0..=kw - m {
-                mul(&pw1[m * n..(m + 1) * n], &pw2[l * n..(l + 1) * n], &mut q);
+                mul_into(&pw1[m * n..(m + 1) * n], &pw2[l * n..(l + 1) * n], &mut q);
                 mixed.extend_from_slice(&q);
                 ml.push((m, l));
-            }
-        }
-        // C(a, b) for a ≤ k
-        let mut binom = vec![0.0; (k + 1) * (k + 1)];
-        for a in 0..=k {
-            binom[a * (k + 1)] = 1.0;
-            for b in 1..=a {
-                binom[a * (k + 1) + b] = binom[(a - 1) * (k + 1) + b - 1] + binom[(a - 1) * (k + 1) + b];
             }
         }
         let mut out = [vec![0.0; shape.len()], vec![0.0; shape.len()], vec![0.0; shape.len()]];
@@ -177,13 +164,12 @@ impl Field for AlongCurve {
                 let j = a - i;
                 tij.iter_mut().for_each(|t| *t = Vec3::ZERO);
                 for (&(m, l), q) in ml.iter().zip(mixed.chunks_exact(n)) {
-                    let w =
-                        d[(i + m) * (k + 1) + j + l] * (binom[(i + m) * (k + 1) + i] * binom[(j + l) * (k + 1) + j]);
+                    let w = d[(i + m) * (k + 1) + j + l] * (binomial(i + m, i) * binomial(j + l, j));
                     for (t, &x) in tij.iter_mut().zip(q) {
                         *t += w * x;
                     }
                 }
-                mul(&nw1[i * n..(i + 1) * n], &nw2[j * n..(j + 1) * n], &mut nn);
+                mul_into(&nw1[i * n..(i + 1) * n], &nw2[j * n..(j + 1) * n], &mut nn);
                 for b in 0..n {
                     let x = (0..=b).fold(Vec3::ZERO, |acc, r| acc + tij[r] * nn[b - r]);
                     let idx = shape.index([a, b, 0]);

@@ -2,6 +2,7 @@
 //! from the neighbouring surfaces, with the cross tangent rotated within each neighbour's
 //! tangent plane near the corners so that it is continuous (see the module `fill`).
 
+use super::series::{binomial, mul};
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
 use crate::jet::{Jet, JetShape};
@@ -51,8 +52,7 @@ fn bump(x: f64, slope: f64, order: usize) -> Vec<f64> {
         let mut acc = 0.0;
         for (n, &a) in p.iter().enumerate().skip(k) {
             // C(n, k) x^(n−k)
-            let binom = (0..k).fold(1.0, |b, i| b * (n - i) as f64 / (i + 1) as f64);
-            acc += a * binom * x.powi((n - k) as i32);
+            acc += a * binomial(n, k) * x.powi((n - k) as i32);
         }
         *o = acc * slope.powi(k as i32);
     }
@@ -72,12 +72,6 @@ pub(crate) fn second_frame(surface: &FieldRef, s: f64, w: f64, t: f64) -> [Vec3;
     let j = surface.jet(&[s, w, t], JetShape::new(&[2, 2, 0]));
     let g = |m: [usize; 3], f: f64| Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m)) * f;
     [g([0, 0, 0], 1.0), g([1, 0, 0], 1.0), g([0, 1, 0], 1.0), g([2, 0, 0], 2.0), g([1, 1, 0], 1.0), g([0, 2, 0], 2.0)]
-}
-
-/// Cauchy product of truncated series.
-fn mul(a: &[f64], b: &[f64]) -> Vec<f64> {
-    let n = a.len().min(b.len());
-    (0..n).map(|k| (0..=k).map(|i| a[i] * b[k - i]).sum()).collect()
 }
 
 /// The loop data: `order` 0 (position), 1 (cross tangent) or 2 (second cross derivative).

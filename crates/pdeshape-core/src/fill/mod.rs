@@ -56,6 +56,7 @@ pub mod disc;
 mod family;
 mod foot;
 mod foot_series;
+mod series;
 
 use crate::Vec3;
 use crate::data::{Field, FieldRef, VecJet};
