@@ -75,12 +75,17 @@ impl FaceSurface {
     }
 
     /// Whether the surface is known to be `C¹` on its domain: analytic surfaces are; a
-    /// B-spline surface when no interior knot has multiplicity of its degree or more and it
-    /// does not close on itself (its seam is not known to be `C¹`).
+    /// B-spline surface when no interior knot has multiplicity of its degree or more and,
+    /// where it closes on itself, its ends meet `C¹` to round-off
+    /// ([`NurbsSurface::seam_c1`]: polynomial, clamped, the end rows of its net and of its
+    /// derivative's net equal).
     pub fn is_c1(&self) -> bool {
         match self {
             FaceSurface::Analytic(_) => true,
-            FaceSurface::Nurbs(n) => n.is_c1() && self.closed() == [false, false],
+            FaceSurface::Nurbs(n) => {
+                let closed = self.closed();
+                n.is_c1() && (0..2).all(|d| !closed[d] || n.seam_c1(d))
+            }
         }
     }
 
@@ -573,8 +578,9 @@ mod tests {
     }
 
     /// Which faces are known `C¹` (and so skip the fills' crease search): a plane; an open
-    /// cubic × quadratic B-spline with a double knot; not with a triple one; not a tube
-    /// closed on itself (a quadratic circle of nine points), however smooth its knots.
+    /// cubic × quadratic B-spline with a double knot; not with a triple one; not a rational
+    /// tube closed on itself (a quadratic circle of nine points), however smooth its knots;
+    /// a polynomial tube whose ends meet C¹, but not with its seam kinked.
     #[test]
     fn faces_known_c1() {
         let plane = AnalyticSurface {
@@ -620,6 +626,31 @@ mod tests {
         let smooth_knots = FaceSurface::Nurbs(Arc::new(smooth_knots.unwrap()));
         assert_eq!(smooth_knots.closed(), [true, false]);
         assert!(!smooth_knots.is_c1());
+        // a polynomial tube whose ends meet C¹ (P₅ = P₀, P₅ − P₄ = P₁ − P₀, equal end
+        // spans): C¹; with P₁ moved, closed but kinked: not
+        let tube = |p1: (f64, f64)| {
+            let ring = [(1.0, 0.0), p1, (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (1.0, 0.0)];
+            let pts: Vec<Vec3> = ring.iter().flat_map(|&(x, y)| [0.0, 1.0].map(|z| Vec3::new(x, y, z))).collect();
+            let ku = vec![0.0, 0.0, 0.0, 0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0, 1.0, 1.0, 1.0];
+            let n = crate::data::NurbsSurface::new((3, 1), ku, vec![0.0, 0.0, 1.0, 1.0], (6, 2), &pts, None).unwrap();
+            FaceSurface::Nurbs(Arc::new(n))
+        };
+        let (smooth, kinked) = (tube((1.0, 1.0)), tube((1.0, 2.0)));
+        assert_eq!((smooth.closed(), kinked.closed()), ([true, false], [true, false]));
+        assert!(smooth.is_c1());
+        assert!(!kinked.is_c1());
+        // the same tube closed along v
+        let across = |p1: (f64, f64)| {
+            let ring = [(1.0, 0.0), p1, (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (1.0, 0.0)];
+            let pts: Vec<Vec3> = [0.0, 1.0].iter().flat_map(|&z| ring.map(|(x, y)| Vec3::new(x, y, z))).collect();
+            let kv = vec![0.0, 0.0, 0.0, 0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0, 1.0, 1.0, 1.0];
+            let n = crate::data::NurbsSurface::new((1, 3), vec![0.0, 0.0, 1.0, 1.0], kv, (2, 6), &pts, None).unwrap();
+            FaceSurface::Nurbs(Arc::new(n))
+        };
+        let (smooth, kinked) = (across((1.0, 1.0)), across((1.0, 2.0)));
+        assert_eq!((smooth.closed(), kinked.closed()), ([false, true], [false, true]));
+        assert!(smooth.is_c1());
+        assert!(!kinked.is_c1());
     }
 
     /// Removing the bottom disc leaves two holes, the rims (the top one and the bottom

@@ -205,6 +205,43 @@ impl NurbsSurface {
         c1_knots(&self.ku, self.nu, self.pu) && c1_knots(&self.kv, self.nv, self.pv)
     }
 
+    /// Whether the surface's two ends in direction `dir` (0: `u`, 1: `v`) meet `C¹` to
+    /// round-off, so that evaluated periodically it is `C¹` across that seam: polynomial,
+    /// both ends clamped (knots of multiplicity `p + 1`), and the end rows of the net and of
+    /// the derivative's net equal to `1e-9` of the largest of each — at a clamped end the
+    /// surface is the B-spline in the other direction on the end row `P_0`, and its
+    /// derivative across the one on `p (P_1 − P_0)/(t_{p+1} − t_1)` (at the far end
+    /// `p (P_{n−1} − P_{n−2})/(t_{n+p−1} − t_{n−1})`). Rational surfaces: `false`.
+    pub fn seam_c1(&self, dir: usize) -> bool {
+        if self.rational {
+            return false;
+        }
+        let (k, n, p, m) =
+            if dir == 0 { (&self.ku, self.nu, self.pu, self.nv) } else { (&self.kv, self.nv, self.pv, self.nu) };
+        let clamped = k[..=p].iter().all(|x| *x == k[0]) && k[n..].iter().all(|x| *x == k[n + p]);
+        let (d0, d1) = (k[p + 1] - k[1], k[n + p - 1] - k[n - 1]);
+        if !(clamped && n >= 2 && d0 > 0.0 && d1 > 0.0) {
+            return false;
+        }
+        // control point (i along `dir`, j across it)
+        let point = |i: usize, j: usize| {
+            let c = &self.cw[if dir == 0 { i * self.nv + j } else { j * self.nv + i }];
+            Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3])
+        };
+        let (mut size, mut slope, mut gap, mut kink) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for j in 0..m {
+            let (a, b) = (point(0, j), point(n - 1, j));
+            let qa = (point(1, j) - a) * (p as f64 / d0);
+            let qb = (b - point(n - 2, j)) * (p as f64 / d1);
+            use crate::num::max_nan;
+            size = max_nan(size, max_nan(a.norm(), b.norm()));
+            slope = max_nan(slope, max_nan(qa.norm(), qb.norm()));
+            gap = max_nan(gap, (a - b).norm());
+            kink = max_nan(kink, (qa - qb).norm());
+        }
+        gap <= 1e-9 * size && kink <= 1e-9 * slope
+    }
+
     /// Bounds `[L_u, L_v]` of `|∂S/∂u|` and `|∂S/∂v|` over the knot ranges, or `None` for a
     /// rational surface. `∂S/∂u` is the B-spline of degree `(p_u − 1, p_v)` with control
     /// points `Q_ij = p_u (P_{i+1,j} − P_ij) / (u_{i+p_u+1} − u_{i+1})` (terms over an empty
