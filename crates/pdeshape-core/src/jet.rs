@@ -127,6 +127,21 @@ impl Jet {
         Jet { shape, c: Coeffs::from_vec(c) }
     }
 
+    /// A jet from raw Taylor coefficients in storage order, copied from a slice (inline up
+    /// to 16 coefficients: no allocation).
+    pub fn from_slice(shape: JetShape, c: &[f64]) -> Self {
+        assert_eq!(c.len(), shape.len());
+        Jet { shape, c: Coeffs::from_slice(c) }
+    }
+
+    /// `s c` for raw Taylor coefficients `c` in storage order: the jet
+    /// `Jet::from_slice(shape, c).scale(s)` without the intermediate copy (the same
+    /// products, the same bits).
+    pub fn from_scaled_slice(shape: JetShape, c: &[f64], s: f64) -> Self {
+        assert_eq!(c.len(), shape.len());
+        Jet { shape, c: c.iter().map(|a| a * s).collect() }
+    }
+
     /// The shape of this jet.
     pub fn shape(&self) -> JetShape {
         self.shape

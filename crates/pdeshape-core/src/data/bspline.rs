@@ -202,6 +202,16 @@ impl Field for BSplineCurve {
 /// span `span`, and their derivatives up to order `min(nd, p)`: row `k`, entry `r` is
 /// `dᵏ N_{span−p+r}/dxᵏ` (The NURBS Book, A2.3, with its final factor `p!/(p−k)!`).
 pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
+    let rows = nd.min(p) + 1;
+    let mut flat = vec![0.0; rows * (p + 1)];
+    basis_derivatives_into(knots, p, span, x, nd, &mut flat);
+    flat.chunks(p + 1).map(<[f64]>::to_vec).collect()
+}
+
+/// [`basis_derivatives`] into `ders`, row `k` (of width `p + 1`) at `k (p + 1)`, for
+/// `k ≤ min(nd, p)`; `ders` holds at least that many rows, those beyond are left alone.
+/// Nothing is allocated up to degree 7.
+pub(crate) fn basis_derivatives_into(knots: &[f64], p: usize, span: usize, x: f64, nd: usize, ders: &mut [f64]) {
     let u = knots;
     // the tables of A2.3 flat and on the stack up to degree 7 (cubics in the mesh collars,
     // called for every jet): `ndu[i][j]` at `i·(p+1) + j`, `a[s][j]` at `s·(p+1) + j`
@@ -238,8 +248,7 @@ pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd
     }
     let ndu = |i: usize, j: usize| ndu[i * w + j];
     let nd = nd.min(p);
-    let mut ders = vec![vec![0.0; p + 1]; nd + 1];
-    for (j, d) in ders[0].iter_mut().enumerate() {
+    for (j, d) in ders[..w].iter_mut().enumerate() {
         *d = ndu(j, p);
     }
     let a: &mut [f64] = if 2 * w <= 16 {
@@ -272,18 +281,17 @@ pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd
                 a[s2 + k] = -a[s1 + k - 1] / ndu(pk + 1, r);
                 d += a[s2 + k] * ndu(r, pk);
             }
-            ders[k][r] = d;
+            ders[k * w + r] = d;
             std::mem::swap(&mut s1, &mut s2);
         }
     }
     let mut f = p as f64;
-    for (k, row) in ders.iter_mut().enumerate().skip(1) {
+    for (k, row) in ders[..(nd + 1) * w].chunks_mut(w).enumerate().skip(1) {
         for x in row.iter_mut() {
             *x *= f;
         }
         f *= (p - k) as f64;
     }
-    ders
 }
 
 #[cfg(test)]

@@ -87,10 +87,17 @@ fn find_span(knots: &[f64], n: usize, p: usize, x: f64) -> usize {
 
 /// Basis derivatives `dᵏNᵣ/dxᵏ / k!` for `k ≤ nd` (zero above the degree), at span `s`.
 fn basis_taylor(knots: &[f64], p: usize, s: usize, x: f64, nd: usize) -> Vec<Vec<f64>> {
-    // the derivatives' own rows divided in place (the same quotients as into new rows)
-    let mut out = super::basis_derivatives(knots, p, s, x, nd);
+    let mut flat = vec![0.0; (nd + 1) * (p + 1)];
+    basis_taylor_into(knots, p, s, x, nd, &mut flat);
+    flat.chunks(p + 1).map(<[f64]>::to_vec).collect()
+}
+
+/// [`basis_taylor`] into `out` (zeros on entry, `nd + 1` rows of width `p + 1`): the rows
+/// `k ≤ min(nd, p)` of A2.3 divided by `k!` in place.
+fn basis_taylor_into(knots: &[f64], p: usize, s: usize, x: f64, nd: usize, out: &mut [f64]) {
+    super::bspline::basis_derivatives_into(knots, p, s, x, nd, out);
     let mut fact = 1.0;
-    for (k, row) in out.iter_mut().enumerate() {
+    for (k, row) in out[..(nd.min(p) + 1) * (p + 1)].chunks_mut(p + 1).enumerate() {
         if k > 0 {
             fact *= k as f64;
         }
@@ -98,8 +105,32 @@ fn basis_taylor(knots: &[f64], p: usize, s: usize, x: f64, nd: usize) -> Vec<Vec
             *o /= fact;
         }
     }
-    out.resize(nd + 1, vec![0.0; p + 1]);
-    out
+}
+
+/// A scratch slice, on the stack up to `N` entries and on the heap beyond: a jet's
+/// tables, without an allocation at the degrees and orders of CAD faces.
+struct Scratch<T, const N: usize> {
+    stack: [T; N],
+    heap: Vec<T>,
+}
+
+impl<T: Copy + Default, const N: usize> Scratch<T, N> {
+    fn new() -> Self {
+        Scratch { stack: [T::default(); N], heap: Vec::new() }
+    }
+
+    /// `n` entries of `T::default()`.
+    fn zeroed(&mut self, n: usize) -> &mut [T] {
+        if n <= N {
+            let s = &mut self.stack[..n];
+            s.fill(T::default());
+            s
+        } else {
+            self.heap.clear();
+            self.heap.resize(n, T::default());
+            &mut self.heap
+        }
+    }
 }
 
 /// Whether a B-spline of degree `p` on `knots` (`n` control points) is `C¹` on its knot
@@ -128,14 +159,18 @@ fn homogeneous(points: &[Vec3], weights: Option<&[f64]>) -> Result<(Vec<[f64; 4]
     Ok((points.iter().zip(w).map(|(p, w)| [p.x * w, p.y * w, p.z * w, *w]).collect(), rational))
 }
 
-/// `A / W` from the homogeneous components' jets (`W` constant when not rational).
-fn quotient(h: [Jet; 4], rational: bool) -> VecJet {
-    let [x, y, z, w] = h;
+/// `A / W` from the homogeneous components' Taylor coefficients, component `q` at
+/// `c[q n .. (q + 1) n]` for the shape's `n` (`W` constant when not rational: then each
+/// coefficient times `1 / W`).
+fn quotient_flat(shape: JetShape, c: &[f64], rational: bool) -> VecJet {
+    let n = shape.len();
+    let part = |q: usize| &c[q * n..(q + 1) * n];
     if rational {
-        VecJet([x.div(&w), y.div(&w), z.div(&w)])
+        let w = Jet::from_slice(shape, part(3));
+        VecJet(std::array::from_fn(|q| Jet::from_slice(shape, part(q)).div(&w)))
     } else {
-        let s = 1.0 / w.value();
-        VecJet([x.scale(s), y.scale(s), z.scale(s)])
+        let s = 1.0 / c[3 * n];
+        VecJet(std::array::from_fn(|q| Jet::from_scaled_slice(shape, part(q), s)))
     }
 }
 
@@ -184,13 +219,20 @@ impl NurbsSurface {
         self.rational
     }
 
+    /// Control point `P_ij` (`i` along `u`, `j` along `v`): the homogeneous net's point
+    /// divided by its weight.
+    fn point(&self, i: usize, j: usize) -> Vec3 {
+        let c = &self.cw[i * self.nv + j];
+        Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3])
+    }
+
     /// The box of the control points `[lo, hi]`: it holds the surface on its knot ranges
     /// (a B-spline with positive weights is a convex combination of its control points).
     pub fn control_box(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let mut hi = -lo;
-        for c in &self.cw {
-            let p = Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3]);
+        for i in 0..self.cw.len() {
+            let p = self.point(i / self.nv, i % self.nv);
             // the points are finite (checked by `new`); a NaN would still propagate
             use crate::num::{max_nan, min_nan};
             lo = Vec3::new(min_nan(lo.x, p.x), min_nan(lo.y, p.y), min_nan(lo.z, p.z));
@@ -224,10 +266,7 @@ impl NurbsSurface {
             return false;
         }
         // control point (i along `dir`, j across it)
-        let point = |i: usize, j: usize| {
-            let c = &self.cw[if dir == 0 { i * self.nv + j } else { j * self.nv + i }];
-            Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3])
-        };
+        let point = |i: usize, j: usize| if dir == 0 { self.point(i, j) } else { self.point(j, i) };
         let (mut size, mut slope, mut gap, mut kink) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for j in 0..m {
             let (a, b) = (point(0, j), point(n - 1, j));
@@ -251,23 +290,25 @@ impl NurbsSurface {
         if self.rational {
             return None;
         }
-        let point = |i: usize, j: usize| {
-            let c = &self.cw[i * self.nv + j];
-            Vec3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3])
-        };
         let mut l = [0.0f64; 2];
         for i in 0..self.nu {
             for j in 0..self.nv {
                 if i + 1 < self.nu {
                     let den = self.ku[i + self.pu + 1] - self.ku[i + 1];
                     if den > 0.0 {
-                        l[0] = crate::num::max_nan(l[0], self.pu as f64 * (point(i + 1, j) - point(i, j)).norm() / den);
+                        l[0] = crate::num::max_nan(
+                            l[0],
+                            self.pu as f64 * (self.point(i + 1, j) - self.point(i, j)).norm() / den,
+                        );
                     }
                 }
                 if j + 1 < self.nv {
                     let den = self.kv[j + self.pv + 1] - self.kv[j + 1];
                     if den > 0.0 {
-                        l[1] = crate::num::max_nan(l[1], self.pv as f64 * (point(i, j + 1) - point(i, j)).norm() / den);
+                        l[1] = crate::num::max_nan(
+                            l[1],
+                            self.pv as f64 * (self.point(i, j + 1) - self.point(i, j)).norm() / den,
+                        );
                     }
                 }
             }
@@ -355,25 +396,34 @@ impl Field for NurbsSurface {
         let (u, v) = (at[0], at.get(1).copied().unwrap_or(0.0));
         let su = find_span(&self.ku, self.nu, self.pu, u);
         let sv = find_span(&self.kv, self.nv, self.pv, v);
-        let bu = basis_taylor(&self.ku, self.pu, su, u, ou);
-        let bv = basis_taylor(&self.kv, self.pv, sv, v, ov);
-        let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
+        let (wu, wv) = (self.pu + 1, self.pv + 1);
+        // the tables on the stack (a jet is asked for at every Newton step of a foot)
+        let (mut bu, mut bv) = (Scratch::<f64, 64>::new(), Scratch::<f64, 64>::new());
+        let bu = bu.zeroed((ou + 1) * wu);
+        let bv = bv.zeroed((ov + 1) * wv);
+        basis_taylor_into(&self.ku, self.pu, su, u, ou, bu);
+        basis_taylor_into(&self.kv, self.pv, sv, v, ov, bv);
+        let n = shape.len();
+        // component `q` at `q n`
+        let mut c = Scratch::<f64, 100>::new();
+        let c = c.zeroed(4 * n);
         // the inner sums depend on the `v` row alone: made once per row, then summed over
         // `u` (the same operations as in `grid_values` and `eval`, the same bits)
-        let mut inner = vec![[0.0; 4]; self.pu + 1];
-        for (k, rowv) in bv.iter().enumerate() {
+        let mut inner = Scratch::<[f64; 4], 16>::new();
+        let inner = inner.zeroed(wu);
+        for (k, rowv) in bv.chunks(wv).enumerate() {
             for (a, x) in inner.iter_mut().enumerate() {
                 *x = self.inner_sum(su - self.pu + a, (sv, rowv));
             }
-            for (i, rowu) in bu.iter().enumerate() {
+            for (i, rowu) in bu.chunks(wu).enumerate() {
                 let idx = shape.index([i, k, 0]);
-                let acc = Self::outer_sum(rowu, &inner);
+                let acc = Self::outer_sum(rowu, inner);
                 for q in 0..4 {
-                    c[q][idx] = acc[q];
+                    c[q * n + idx] = acc[q];
                 }
             }
         }
-        quotient(c.map(|c| Jet::from_coeffs(shape, c)), self.rational)
+        quotient_flat(shape, c, self.rational)
     }
 
     fn is_constant_in(&self, slot: usize) -> bool {
@@ -441,18 +491,23 @@ impl Field for NurbsCurve {
         let [o, _, _] = shape.orders();
         let n = self.cw.len();
         let s = find_span(&self.knots, n, self.p, at[0]);
-        let b = basis_taylor(&self.knots, self.p, s, at[0], o);
-        let mut c: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; shape.len()]);
-        for (k, row) in b.iter().enumerate() {
+        let w = self.p + 1;
+        let mut b = Scratch::<f64, 64>::new();
+        let b = b.zeroed((o + 1) * w);
+        basis_taylor_into(&self.knots, self.p, s, at[0], o, b);
+        let n = shape.len();
+        let mut c = Scratch::<f64, 100>::new();
+        let c = c.zeroed(4 * n);
+        for (k, row) in b.chunks(w).enumerate() {
             let idx = shape.index([k, 0, 0]);
             for (a, nb) in row.iter().enumerate() {
                 let p = &self.cw[s - self.p + a];
                 for q in 0..4 {
-                    c[q][idx] += nb * p[q];
+                    c[q * n + idx] += nb * p[q];
                 }
             }
         }
-        quotient(c.map(|c| Jet::from_coeffs(shape, c)), self.rational)
+        quotient_flat(shape, c, self.rational)
     }
 
     fn is_constant_in(&self, slot: usize) -> bool {
@@ -610,6 +665,51 @@ mod tests {
             assert!((j.value() - want).norm() < 1e-15, "{u} {v}");
             assert!((j.derivative([1, 1, 0]) - Vec3::new(0.0, 0.0, 2.0)).norm() < 1e-14);
             assert!((j.derivative([0, 2, 0])).norm() < 1e-13);
+        }
+    }
+
+    /// Bézier surfaces of degrees (17, 9) and (5, 2) whose net gives `x = u`, `y = v`,
+    /// `z = u³ v²` (`uᵏ = Σᵢ C(i, k)/C(p, k) Bᵢᵖ(u)`), against the Taylor coefficients of
+    /// `u³ v²` by hand, `C(3, i) u³⁻ⁱ C(2, j) v²⁻ʲ`, through shapes `[5, 5]` and `[2, 2]`:
+    /// the jet's tables on the heap (degree 17, 36 coefficients) and on the stack.
+    #[test]
+    fn high_degree_jets_against_the_power_form() {
+        let c =
+            |n: usize, k: usize| if k > n { 0.0 } else { (0..k).map(|i| (n - i) as f64 / (k - i) as f64).product() };
+        for ((pu, pv), o) in [((17, 9), 5), ((5, 2), 2), ((9, 3), 3)] {
+            let knots = |p: usize| [vec![0.0; p + 1], vec![1.0; p + 1]].concat();
+            let pts: Vec<Vec3> = (0..(pu + 1) * (pv + 1))
+                .map(|k| {
+                    let (i, j) = (k / (pv + 1), k % (pv + 1));
+                    let z = c(i, 3) / c(pu, 3) * c(j, 2) / c(pv, 2);
+                    Vec3::new(i as f64 / pu as f64, j as f64 / pv as f64, z)
+                })
+                .collect();
+            let s = NurbsSurface::new((pu, pv), knots(pu), knots(pv), (pu + 1, pv + 1), &pts, None).unwrap();
+            for (u, v) in [(0.3, 0.8), (0.91, 0.05), (0.5, 0.5)] {
+                let shape = JetShape::new(&[o, o]);
+                let j = s.jet(&[u, v], shape);
+                for i in 0..=o {
+                    for k in 0..=o {
+                        let m = [i, k, 0];
+                        let z = c(3, i) * u.powi(3 - i.min(3) as i32) * c(2, k) * v.powi(2 - k.min(2) as i32);
+                        let x = [u, 1.0][..].get(i).copied().filter(|_| k == 0).unwrap_or(0.0);
+                        let y = [v, 1.0][..].get(k).copied().filter(|_| i == 0).unwrap_or(0.0);
+                        let got = Vec3::new(j.0[0].coeff(m), j.0[1].coeff(m), j.0[2].coeff(m));
+                        // round-off: the sum cancels basis coefficients of size `Σ|Nᵢ|Σ|Mₖ|`
+                        // (up to 1e4 at degree 17, order 5) over a net of points ≤ 1, a few
+                        // dozen ulps of that
+                        let size = |k: &[f64], p: usize, x: f64, r: usize| {
+                            basis_taylor(k, p, p, x, r)[r].iter().map(|b| b.abs()).sum::<f64>()
+                        };
+                        let tol = 64.0 * f64::EPSILON * size(&knots(pu), pu, u, i) * size(&knots(pv), pv, v, k);
+                        assert!(
+                            (got - Vec3::new(x, y, z)).norm() <= tol,
+                            "{pu} {pv} ({u}, {v}) {m:?}: {got} tol {tol}"
+                        );
+                    }
+                }
+            }
         }
     }
 
