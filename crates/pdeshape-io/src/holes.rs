@@ -8,7 +8,7 @@
 use crate::export::{SewnFace, sewn_step, write_atomic};
 use crate::import::step::StepModel;
 use pdeshape_core::Vec3;
-use pdeshape_core::brep::{Brep, Hole, HoleKind, HoleUse, StartGrid, box_distance, fill_hole};
+use pdeshape_core::brep::{Brep, Hole, HoleKind, HoleUse, box_distance, fill_hole};
 use pdeshape_core::fill::{Fill, FillOptions, foot_of};
 use pdeshape_core::fit::{BSplineSurface, EdgeTolerance, FitOptions, FitReport, fit_surface};
 use pdeshape_core::num::{max_nan, min_nan};
@@ -250,12 +250,11 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
     let mut seeds: Vec<Option<[f64; 2]>> = vec![None; faces.len()];
     // each face's field made once (a closed B-spline face's is periodic, `FaceSurface::field`)
     let fields: Vec<Option<_>> = faces.iter().map(|&fi| b.faces[fi].surface.as_ref().map(|s| s.field())).collect();
-    // each face's box, and its start grid made when first needed: the faces next to the
-    // nearest are searched afresh at most samples of a many-sided hole (their feet from
-    // the last leave the face), and a grid costs thousands of evaluations
+    // each face's box; its start grid is the face's own, made once per model
+    // (`BrepFace::start_grid`): the faces next to the nearest are searched afresh at most
+    // samples of a many-sided hole (their feet from the last leave the face)
     let boxes: Vec<Option<_>> =
         faces.iter().map(|&fi| b.faces[fi].surface.as_ref().and_then(|s| s.bounding_box())).collect();
-    let mut grids: Vec<Option<StartGrid>> = vec![None; faces.len()];
     // the face chosen for the previous sample (its foot is found first, and bounds which
     // faces can be nearer)
     let mut previous: Option<usize> = None;
@@ -264,8 +263,9 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
         let d = s.derivatives(0.0, v, 2, 2);
         let p = d[0];
         // face k's foot of p from its last foot, and its distance
-        let foot = |k: usize, seed: Option<[f64; 2]>, grid: &mut Option<StartGrid>| -> Option<([f64; 2], f64)> {
-            let (Some(fs), Some(field)) = (&b.faces[faces[k]].surface, &fields[k]) else { return None };
+        let foot = |k: usize, seed: Option<[f64; 2]>| -> Option<([f64; 2], f64)> {
+            let face = &b.faces[faces[k]];
+            let (Some(fs), Some(field)) = (&face.surface, &fields[k]) else { return None };
             // a foot outside a B-spline face's domain (the last foot carried across a closed
             // face's seam) is on its extrapolation, not on the face: from there moved by the
             // period, or searched afresh
@@ -276,10 +276,10 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
                 }
                 foot_of(field.as_ref(), p, fs.wrap(c), 0.0).filter(|c| fs.in_domain(*c))
             };
-            let c = seed.and_then(settle).or_else(|| settle(grid.get_or_insert_with(|| fs.start_grid()).start(p)))?;
+            let c = seed.and_then(settle).or_else(|| settle(face.start_grid()?.start(p)))?;
             Some((c, (field.eval(&c) - p).norm()))
         };
-        let first = previous.map(|k| (k, foot(k, seeds[k], &mut grids[k])));
+        let first = previous.map(|k| (k, foot(k, seeds[k])));
         // branch and bound: no face whose surface lies farther than the nearest foot found
         // so far can be the nearest, so the faces are tried nearest box first and skipped
         // once their box, or their start grid less its slack, lies farther than that foot
@@ -304,12 +304,10 @@ pub fn measure_seam(b: &Brep, faces: &[usize], s: &BSplineSurface, samples: usiz
             if near > bound {
                 continue;
             }
-            if let Some(fs) = &b.faces[faces[k]].surface
-                && grids[k].get_or_insert_with(|| fs.start_grid()).distance_bound(p).is_some_and(|x| x > bound)
-            {
+            if b.faces[faces[k]].start_grid().and_then(|g| g.distance_bound(p)).is_some_and(|x| x > bound) {
                 continue;
             }
-            let Some((c, dist)) = foot(k, seeds[k], &mut grids[k]) else { continue };
+            let Some((c, dist)) = foot(k, seeds[k]) else { continue };
             seeds[k] = Some(c);
             if best.is_none_or(|x| dist < x.0) {
                 best = Some((dist, k, c));

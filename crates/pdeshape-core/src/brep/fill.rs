@@ -131,7 +131,7 @@ pub fn edge_pieces(b: &Brep, u: &HoleUse, cuts: usize, t: f64) -> Result<EdgePie
     for c in 0..cuts {
         let ta = a + (z - a) * c as f64 / cuts as f64;
         let tb = a + (z - a) * (c + 1) as f64 / cuts as f64;
-        let start = surface.invert_near(curve.eval(&[ta]));
+        let start = f.start_grid().expect("the face has a surface").start(curve.eval(&[ta]));
         let foot = FootCurve::new(host.clone(), curve.clone(), (ta, tb), start, t)
             .map_err(|err| HoleFillError::Foot { edge: e.id, face: f.id, err })?;
         out.offset = max_nan(out.offset, foot.max_distance());

@@ -14,7 +14,7 @@
 //! closes the smallest loop around the gap. Two free edges leaving the same vertex entity
 //! remain a loop that touches itself.
 
-use super::{Brep, FaceSurface};
+use super::{Brep, BrepFace};
 use crate::Vec3;
 use crate::classes::Classes;
 use crate::data::analytic::Frame;
@@ -114,11 +114,11 @@ impl Hole {
     }
 }
 
-fn oriented_normal(s: Option<&FaceSurface>, same_sense: bool, p: Vec3) -> Option<Vec3> {
-    let s = s?;
-    let c = foot_of(s.field().as_ref(), p, s.invert_near(p), 0.0)?;
+fn oriented_normal(f: &BrepFace, p: Vec3) -> Option<Vec3> {
+    let s = f.surface.as_ref()?;
+    let c = foot_of(s.field().as_ref(), p, f.start_grid()?.start(p), 0.0)?;
     let n = s.normal(c)?;
-    Some(if same_sense { n } else { -n })
+    Some(if f.same_sense { n } else { -n })
 }
 
 /// For each vertex, the smallest index of the vertices within `tol` of it (transitively):
@@ -212,7 +212,7 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
                 // the face arriving (NaN turns last)
                 let p = b.vertices[ends(&last).1].1;
                 let f = &b.faces[last.face];
-                let n = oriented_normal(f.surface.as_ref(), f.same_sense, p);
+                let n = oriented_normal(f, p);
                 let t_in = tangent(b, &last, true);
                 let turn = |k: usize| {
                     let t = tangent(b, &free[k], false);
@@ -254,10 +254,7 @@ pub fn holes(b: &Brep) -> Vec<Hole> {
                     let vertex = ends(a).1;
                     let p = b.vertices[vertex].1;
                     let (fa, fc) = (&b.faces[a.face], &b.faces[c.face]);
-                    let angle = match (
-                        oriented_normal(fa.surface.as_ref(), fa.same_sense, p),
-                        oriented_normal(fc.surface.as_ref(), fc.same_sense, p),
-                    ) {
+                    let angle = match (oriented_normal(fa, p), oriented_normal(fc, p)) {
                         (Some(n), Some(m)) => n.cross(m).norm().atan2(n.dot(m)),
                         _ => f64::NAN,
                     };

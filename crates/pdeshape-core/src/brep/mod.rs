@@ -16,7 +16,7 @@ use crate::data::analytic::{AnalyticCurve, AnalyticSurface};
 use crate::data::{Field, FieldRef, NurbsCurve, NurbsSurface};
 use crate::jet::JetShape;
 use crate::num::{max_nan, min_nan};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 pub use fill::{EdgePieces, HoleFill, HoleFillError, edge_pieces, fill_hole, fill_uses, pieces_per_edge};
 pub use holes::{Corner, Hole, HoleKind, HoleUse, holes};
@@ -95,12 +95,6 @@ impl FaceSurface {
     pub fn bounding_box(&self) -> Option<(Vec3, Vec3)> {
         let FaceSurface::Nurbs(n) = self else { return None };
         Some(n.control_box())
-    }
-
-    /// A lower bound of the distance from `p` to the surface on its domain, or `None` where
-    /// none is known: the distance to its [`bounding_box`](Self::bounding_box).
-    pub fn distance_bound(&self, p: Vec3) -> Option<f64> {
-        self.bounding_box().map(|b| box_distance(b, p))
     }
 
     /// Whether `c` lies in the surface's parameter domain (to 1e-6 of its extent, where
@@ -298,6 +292,30 @@ pub struct BrepFace {
     pub loops: Vec<Vec<(usize, bool)>>,
     /// The shell it belongs to (index into [`Brep::shells`]).
     pub shell: usize,
+    /// Its surface's start grid, made at the first [`start_grid`](Self::start_grid) and kept:
+    /// a grid costs thousands of evaluations of a B-spline face, and the corners of a hole,
+    /// its fill and the seam measure all look for feet on the same faces.
+    start: OnceLock<Option<StartGrid>>,
+}
+
+impl BrepFace {
+    /// A face of `surface` with its `loops` (see the fields).
+    pub fn new(
+        id: u64,
+        name: String,
+        surface: Option<FaceSurface>,
+        same_sense: bool,
+        loops: Vec<Vec<(usize, bool)>>,
+        shell: usize,
+    ) -> Self {
+        BrepFace { id, name, surface, same_sense, loops, shell, start: OnceLock::new() }
+    }
+
+    /// The surface's [`FaceSurface::start_grid`], made once per face (`None` without a
+    /// surface). The grid belongs to the surface the face had at the first call.
+    pub fn start_grid(&self) -> Option<&StartGrid> {
+        self.start.get_or_init(|| self.surface.as_ref().map(FaceSurface::start_grid)).as_ref()
+    }
 }
 
 /// An edge.
@@ -475,25 +493,19 @@ mod tests {
         };
         let cylinder = FaceSurface::Analytic(AnalyticSurface { kind: AnalyticKind::Cylinder { r: 1.0 }, frame });
         let faces = vec![
-            BrepFace { id: 20, name: String::new(), surface: Some(cylinder), same_sense, loops: vec![wall], shell: 0 },
-            BrepFace {
-                id: 21,
-                name: String::new(),
-                surface: Some(plane(0.0)),
-                same_sense: !same_sense,
-                loops: vec![vec![(0, !same_sense)]],
-                shell: 0,
-            },
+            BrepFace::new(20, String::new(), Some(cylinder), same_sense, vec![wall], 0),
+            BrepFace::new(21, String::new(), Some(plane(0.0)), !same_sense, vec![vec![(0, !same_sense)]], 0),
         ];
         Brep { faces, edges, vertices, shells: vec![BrepShell { id: 30, closed: false, faces: vec![0, 1] }] }
     }
 
-    /// The distance bound never exceeds the distance to a point of the face: a rational
+    /// The distance to the bounding box never exceeds the distance to a point of the face
+    /// (a lower bound of the distance to the face): a rational
     /// bicubic whose weights pull it off its polynomial shape, against its points on a
     /// 45 × 45 grid and 7 × 7 × 5 points around (inside and outside its box). With the weights
     /// left out of the box (`w x` for `x`) it fails. Analytic surfaces have no bound.
     #[test]
-    fn the_distance_bound_is_below_every_distance_to_the_face() {
+    fn the_box_distance_is_below_every_distance_to_the_face() {
         let (p, n) = (3, 6);
         let k: Vec<f64> = [vec![0.0; 4], vec![0.4, 0.7], vec![1.0; 4]].concat();
         let pts: Vec<Vec3> = (0..n * n)
@@ -510,7 +522,7 @@ mod tests {
         let lattice = (0..7 * 7 * 5)
             .map(|i| Vec3::new((i / 35) as f64 * 1.3 - 2.0, (i / 5 % 7) as f64 * 1.2 - 3.0, (i % 5) as f64 - 2.0));
         for q in lattice {
-            let bound = face.distance_bound(q).unwrap();
+            let bound = box_distance(face.bounding_box().unwrap(), q);
             let nearest = on.iter().map(|x| (*x - q).norm()).fold(f64::INFINITY, crate::num::min_nan);
             assert!(bound <= nearest, "{q}: bound {bound} above {nearest}");
         }
@@ -518,7 +530,7 @@ mod tests {
             kind: AnalyticKind::Plane,
             frame: Frame::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0), None).unwrap(),
         };
-        assert_eq!(FaceSurface::Analytic(plane).distance_bound(Vec3::ZERO), None);
+        assert_eq!(FaceSurface::Analytic(plane).bounding_box(), None);
     }
 
     /// The start grid's distance bound on a polynomial (weights all 2) surface of degrees
@@ -575,6 +587,28 @@ mod tests {
         let r = crate::data::NurbsSurface::new((3, 2), ku, kv, (nu, nv), &pts, Some(&w)).unwrap();
         assert_eq!(r.derivative_bounds(), None);
         assert_eq!(FaceSurface::Nurbs(Arc::new(r)).start_grid().distance_bound(Vec3::ZERO), None);
+    }
+
+    /// A face's start grid is made once and kept (the same grid at every call, with the
+    /// values of `FaceSurface::start_grid`, also in a clone of the face); none without a
+    /// surface.
+    #[test]
+    fn a_face_keeps_its_start_grid() {
+        let b = open_cylinder(true);
+        let k: Vec<f64> = [vec![0.0; 3], vec![1.0; 3]].concat();
+        let pts: Vec<Vec3> = (0..9).map(|i| Vec3::new((i / 3) as f64, (i % 3) as f64, ((i * i) % 5) as f64)).collect();
+        let s = Arc::new(crate::data::NurbsSurface::new((2, 2), k.clone(), k, (3, 3), &pts, None).unwrap());
+        let face = BrepFace::new(7, String::new(), Some(FaceSurface::Nurbs(s.clone())), true, Vec::new(), 0);
+        let first = face.start_grid().unwrap() as *const StartGrid;
+        assert!(std::ptr::eq(first, face.start_grid().unwrap()));
+        let StartGrid::Grid { values, .. } = face.start_grid().unwrap() else { panic!("a B-spline face's grid") };
+        let StartGrid::Grid { values: fresh, .. } = FaceSurface::Nurbs(s).start_grid() else { panic!() };
+        assert_eq!(values, &fresh);
+        let clone = face.clone();
+        let StartGrid::Grid { values: cloned, .. } = clone.start_grid().unwrap() else { panic!() };
+        assert_eq!(cloned, &fresh);
+        assert!(matches!(b.faces[0].start_grid(), Some(StartGrid::Analytic(_))));
+        assert!(BrepFace::new(8, String::new(), None, true, Vec::new(), 0).start_grid().is_none());
     }
 
     /// Which faces are known `C¹` (and so skip the fills' crease search): a plane; an open

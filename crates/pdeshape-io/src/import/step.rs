@@ -522,7 +522,7 @@ impl<'g> Reader<'g> {
             self.check_loop(lid, &lp)?;
             loops.push(lp);
         }
-        self.brep.faces.push(BrepFace { id, name, surface, same_sense, loops, shell });
+        self.brep.faces.push(BrepFace::new(id, name, surface, same_sense, loops, shell));
         Ok(self.brep.faces.len() - 1)
     }
 
