@@ -210,76 +210,75 @@ pub(crate) fn basis_derivatives(knots: &[f64], p: usize, span: usize, x: f64, nd
 
 /// [`basis_derivatives`] into `ders`, row `k` (of width `p + 1`) at `k (p + 1)`, for
 /// `k ≤ min(nd, p)`; `ders` holds at least that many rows, those beyond are left alone.
-/// Nothing is allocated up to degree 7.
+/// Nothing is allocated. Degrees 1 … 7 (the faces of CAD files, the fits' cubics and
+/// quintics) each get their own instance, whose loops the compiler unrolls and whose
+/// indices it checks once; the operations are the same at every degree (the same bits).
 pub(crate) fn basis_derivatives_into(knots: &[f64], p: usize, span: usize, x: f64, nd: usize, ders: &mut [f64]) {
-    let u = knots;
-    // the tables of A2.3 flat and on the stack up to degree 7 (cubics in the mesh collars,
-    // called for every jet): `ndu[i][j]` at `i·(p+1) + j`, `a[s][j]` at `s·(p+1) + j`
-    // (stack arrays and slices of them, not `SmallVec`s: each of their indexings asks
-    // whether the data are inline, 5 % of a twelve-edge hole's fill)
+    match p {
+        1 => a23::<2>(knots, 1, span, x, nd, ders),
+        2 => a23::<3>(knots, 2, span, x, nd, ders),
+        3 => a23::<4>(knots, 3, span, x, nd, ders),
+        4 => a23::<5>(knots, 4, span, x, nd, ders),
+        5 => a23::<6>(knots, 5, span, x, nd, ders),
+        6 => a23::<7>(knots, 6, span, x, nd, ders),
+        7 => a23::<8>(knots, 7, span, x, nd, ders),
+        // (tables sized to the degree: they are zeroed at every call)
+        8..=11 => a23::<12>(knots, p, span, x, nd, ders),
+        _ => a23::<{ MAX_BASIS_DEGREE + 1 }>(knots, p, span, x, nd, ders),
+    }
+}
+
+/// The highest degree [`basis_derivatives`] takes (that of the NURBS a file may hold).
+const MAX_BASIS_DEGREE: usize = 25;
+
+/// The NURBS Book's A2.3 for degree `p < W` in tables of `W × W`: `ndu[j][r]` for `r < j`
+/// the knot differences, for `r ≥ j` the basis functions of degree `j`; `a` the two rows
+/// of derivative coefficients in turn.
+#[inline(always)]
+fn a23<const W: usize>(u: &[f64], p: usize, span: usize, x: f64, nd: usize, ders: &mut [f64]) {
+    assert!(p < W, "degree {p} above {}", W - 1);
     let w = p + 1;
-    let (mut ndu_stack, mut lr_stack, mut a_stack) = ([0.0; 64], [0.0; 16], [0.0; 16]);
-    let (mut ndu_heap, mut lr_heap, mut a_heap) = (Vec::new(), Vec::new(), Vec::new());
-    let ndu: &mut [f64] = if w * w <= 64 {
-        &mut ndu_stack[..w * w]
-    } else {
-        ndu_heap.resize(w * w, 0.0);
-        &mut ndu_heap
-    };
-    let lr: &mut [f64] = if 2 * w <= 16 {
-        &mut lr_stack[..2 * w]
-    } else {
-        lr_heap.resize(2 * w, 0.0);
-        &mut lr_heap
-    };
-    let (left, right) = lr.split_at_mut(w);
-    ndu[0] = 1.0;
+    let mut ndu = [[0.0; W]; W];
+    let (mut left, mut right) = ([0.0; W], [0.0; W]);
+    ndu[0][0] = 1.0;
     for j in 1..=p {
         left[j] = x - u[span + 1 - j];
         right[j] = u[span + j] - x;
         let mut saved = 0.0;
         for r in 0..j {
-            ndu[j * w + r] = right[r + 1] + left[j - r];
-            let temp = ndu[r * w + j - 1] / ndu[j * w + r];
-            ndu[r * w + j] = saved + right[r + 1] * temp;
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
         }
-        ndu[j * w + j] = saved;
+        ndu[j][j] = saved;
     }
-    let ndu = |i: usize, j: usize| ndu[i * w + j];
     let nd = nd.min(p);
     for (j, d) in ders[..w].iter_mut().enumerate() {
-        *d = ndu(j, p);
+        *d = ndu[j][p];
     }
-    let a: &mut [f64] = if 2 * w <= 16 {
-        &mut a_stack[..2 * w]
-    } else {
-        a_heap.resize(2 * w, 0.0);
-        &mut a_heap
-    };
-    // `r` indexes A2.3's tables as well as `ders`
-    #[allow(clippy::needless_range_loop)]
+    let mut a = [[0.0; W]; 2];
     for r in 0..=p {
-        let (mut s1, mut s2) = (0usize, w);
-        a[0] = 1.0;
+        let (mut s1, mut s2) = (0, 1);
+        a[0][0] = 1.0;
         for k in 1..=nd {
             let mut d = 0.0;
             let rk = r as isize - k as isize;
             let pk = p - k;
             if r >= k {
-                a[s2] = a[s1] / ndu(pk + 1, rk as usize);
-                d = a[s2] * ndu(rk as usize, pk);
+                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                d = a[s2][0] * ndu[rk as usize][pk];
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
             let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
             for j in j1..=j2 {
                 let idx = (rk + j as isize) as usize;
-                a[s2 + j] = (a[s1 + j] - a[s1 + j - 1]) / ndu(pk + 1, idx);
-                d += a[s2 + j] * ndu(idx, pk);
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                d += a[s2][j] * ndu[idx][pk];
             }
             if r <= pk {
-                a[s2 + k] = -a[s1 + k - 1] / ndu(pk + 1, r);
-                d += a[s2 + k] * ndu(r, pk);
+                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                d += a[s2][k] * ndu[r][pk];
             }
             ders[k * w + r] = d;
             std::mem::swap(&mut s1, &mut s2);
@@ -298,6 +297,59 @@ pub(crate) fn basis_derivatives_into(knots: &[f64], p: usize, span: usize, x: f6
 mod tests {
     use super::*;
     use crate::data::Field;
+
+    /// A2.3 at every degree 1 … 25 (each of its table sizes) against the Cox–de Boor
+    /// recursion and its derivative `N⁽ᵏ⁾ᵢ,q = q (N⁽ᵏ⁻¹⁾ᵢ,q₋₁/(uᵢ₊q − uᵢ) −
+    /// N⁽ᵏ⁻¹⁾ᵢ₊₁,q₋₁/(uᵢ₊q₊₁ − uᵢ₊₁))` (terms over empty intervals dropped), tabulated bottom
+    /// up: clamped knots with a double interior knot, at points inside spans, at a knot and
+    /// at the ends, derivatives to order 4. A table one entry too small, or a degree sent
+    /// to the wrong instance, fails.
+    #[test]
+    fn a23_against_cox_de_boor() {
+        for p in 1..=25usize {
+            let inner = [0.13, 0.4, 0.4, 0.55, 0.9];
+            let u: Vec<f64> = [vec![0.0; p + 1], inner.to_vec(), vec![1.0; p + 1]].concat();
+            let n = u.len() - p - 1;
+            for x in [0.0, 0.07, 0.4, 0.47, 0.731, 1.0] {
+                // the span as the evaluators find it (the last non-empty one at the end)
+                let span = (p..n).rev().find(|&s| u[s] <= x && u[s] < u[s + 1]).unwrap();
+                let nd = 4;
+                let rows = nd.min(p) + 1;
+                let mut got = vec![f64::NAN; rows * (p + 1)];
+                basis_derivatives_into(&u, p, span, x, nd, &mut got);
+                // cdb[k][q][i]: dᵏ N_{i,q} / dxᵏ, the degree-0 functions of span `span`
+                let m = u.len() - 1;
+                let mut cdb = vec![vec![vec![0.0; m]; p + 1]; nd + 1];
+                cdb[0][0][span] = 1.0;
+                let ratio = |a: f64, b: f64| if b == 0.0 { 0.0 } else { a / b };
+                for q in 1..=p {
+                    for i in 0..m - q {
+                        let (l, r) = (u[i + q] - u[i], u[i + q + 1] - u[i + 1]);
+                        cdb[0][q][i] =
+                            ratio(x - u[i], l) * cdb[0][q - 1][i] + ratio(u[i + q + 1] - x, r) * cdb[0][q - 1][i + 1];
+                        for k in 1..=nd {
+                            cdb[k][q][i] =
+                                q as f64 * (ratio(cdb[k - 1][q - 1][i], l) - ratio(cdb[k - 1][q - 1][i + 1], r));
+                        }
+                    }
+                }
+                for k in 0..rows {
+                    let want: Vec<f64> = (0..=p).map(|r| cdb[k][p][span - p + r]).collect();
+                    let size = want.iter().map(|w| w.abs()).fold(1.0, crate::num::max_nan);
+                    for r in 0..=p {
+                        let g = got[k * (p + 1) + r];
+                        // both sum the same terms in other orders: round-off of the row's
+                        // largest entry times the degree
+                        assert!(
+                            (g - want[r]).abs() <= 1e-14 * (p * p) as f64 * size,
+                            "p {p} x {x} k {k} r {r}: {g} vs {}",
+                            want[r]
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     /// The one-slot path and the jet path give the same derivatives (to round-off: both
     /// sum the same basis derivatives, the jet divides by k! and multiplies back), in the
