@@ -139,7 +139,12 @@ impl Jet {
     /// products, the same bits).
     pub fn from_scaled_slice(shape: JetShape, c: &[f64], s: f64) -> Self {
         assert_eq!(c.len(), shape.len());
-        Jet { shape, c: c.iter().map(|a| a * s).collect() }
+        // copied whole, then scaled in place (collecting from an iterator pushes one by one)
+        let mut c = Coeffs::from_slice(c);
+        for a in c.iter_mut() {
+            *a *= s;
+        }
+        Jet { shape, c }
     }
 
     /// The shape of this jet.

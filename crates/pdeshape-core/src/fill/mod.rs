@@ -780,11 +780,17 @@ impl LoopSetup {
                 corner_curvature_gaps.push((q1 - q0).dot(nrm).abs() / tc.dot(tc) * radius);
             }
         }
+        // each edge's surface kept per point for the conditions: at a `v` the position,
+        // the cross tangent (and the second cross derivative) ask its jets at the same
+        // point (on CAD faces each jet is a foot and a reparametrisation in Taylor
+        // arithmetic), so one jet, across to the conditions' order and along to the
+        // second derivative, answers them all
+        let cover = JetShape::new(&[if o.order == 6 { 2 } else { 1 }, 2, 0]);
         let pieces: Vec<Piece> = edges
             .iter()
             .enumerate()
             .map(|(k, e)| Piece {
-                surface: e.surface.clone(),
+                surface: Arc::new(crate::data::MemoField::covering(e.surface.clone(), cover)),
                 s0: e.s0,
                 w0: e.w.0,
                 lambda: (e.w.1 - e.w.0) * n as f64 / TAU,
