@@ -319,10 +319,11 @@ mod tests {
 
     /// The construction's walk along the helix of the test above, lifted 1e-3, for
     /// `τ ∈ [0.5, 2.5]`: its 129 feet are the closed form's `(τ², τ³)` to round-off, the
-    /// distance is the lift, and each foot costs four jets of the surface — two Newton
-    /// steps from the line through the two feet before, the last one's data checking the
-    /// foot, and its point. Newton from the last foot alone takes 598, with a separate
-    /// check of each foot 643 (both checked).
+    /// distance is the lift, and each foot costs four jets of the surface: three Newton
+    /// steps from the line through the two feet before (the third finds its step below
+    /// round-off, and its tangents check the foot) and the foot's point. Newton from the
+    /// last foot alone takes 598 in all, with a separate check of each foot 643 (both
+    /// checked).
     #[test]
     fn the_walk_predicts_each_foot() {
         let host = Arc::new(ExprField::parse(["2*cos(u)", "2*sin(u)", "v"], &["u", "v", "t"], &|_| None).unwrap());
