@@ -20,7 +20,9 @@
 //!   continuity is within the tolerance).
 //! - **Measured maximum** (not a proved bound): the parametric deviation `|S(u, v) − X(u, v)|` bounds the distance of
 //!   every point of `S` from the patch. It is sampled on a 7 × 7 grid in every knot-span
-//!   cell, and from every discrete local maximum of those samples it is maximised locally (projected gradient ascent with exact derivatives of `S` and `X`).
+//!   cell, and from every discrete local maximum of those samples it is maximised locally
+//!   (projected Newton steps on `ln|S − X|` with exact first and second derivatives of `S`
+//!   and `X`, gradient steps where the model is not concave).
 //!   The reported maximum is the largest value found; a bump narrower than the
 //!   sample spacing can lie between the samples and be missed.
 //! - **Refinement**: every knot span in `u` (and in `v`) that holds a cell above the
@@ -444,9 +446,26 @@ fn cell_deviations(s: &dyn Surface, b: &BSplineSurface, tol: f64) -> (Vec<(f64, 
     (out, evals)
 }
 
-/// Projected gradient ascent of `|S − X|` within a cell from `(u, v)`, with exact
-/// derivatives; step halved until the value grows. Lengths are scaled norms, so a patch
-/// at 1e-160 or 1e160 is measured as one at 1 (no square underflows or overflows).
+/// Local maximisation of `|S − X|` within a cell from `(u, v)`, with exact first and second
+/// derivatives of `S` and `X`: Newton's method on `ψ = ln|e| = ½ ln 2φ`, `φ = ½|e|²`,
+/// `e = S − X`,
+///
+/// `∇φ = (e·e_u, e·e_v)`, `∇²φ = [e_u·e_u + e·e_uu, e_u·e_v + e·e_uv; ·, e_v·e_v + e·e_vv]`,
+/// `∇ψ = ∇φ / 2φ`, `∇²ψ = ∇²φ / 2φ − ∇φ ∇φᵀ / 2φ²`,
+///
+/// with the step `δ = −(∇²ψ)⁻¹∇ψ` where `∇²ψ` is negative definite (a wider region than
+/// where `∇²φ` is; a Gaussian bump's `ψ` is quadratic: one step), projected on the cell: a
+/// coordinate at a side of the cell whose gradient points out of it is held there and the
+/// other one takes the one-dimensional step. `t δ` grows `ψ`, that is `|e|` relative to
+/// itself, by `P t (2 − t)` in the quadratic model, `P = ½ ∇ψ·δ`. The maximisation stops
+/// where `|e|` would grow (or grew) by less than 5e-10 of itself or than its round-off,
+/// `16 ε |X| / |e|` (a deviation of 1e-10 on a patch of size 1 is known to ~1e-5 of
+/// itself only). A full step that does not grow `|e|` is halved, at most three times;
+/// where `∇²ψ` is not negative definite, or the halved steps fail too (the model is wrong
+/// there: a kink at the cell's side), a gradient step is taken instead, halved until `|e|`
+/// grows. Everything is divided by `|e|` first (a scaled norm), so a patch at 1e-160 or
+/// 1e160 is measured as one at 1 (no square underflows or overflows). Returns the
+/// maximum, its place and the evaluations made.
 fn local_max(
     s: &dyn Surface,
     b: &BSplineSurface,
@@ -455,59 +474,126 @@ fn local_max(
     ru: (f64, f64),
     rv: (f64, f64),
 ) -> (f64, f64, f64, usize) {
-    // the patch through its scattered-point evaluation (batches of one point: no row of
-    // cardinal functions computed and cached for a `u` that the ascent never visits again)
+    // e and its derivatives [e, e_u, e_v, e_uu, e_uv, e_vv] at (u, v), and |X|: the patch
+    // through its scattered-point evaluation (batches of one point: no row of cardinal
+    // functions computed and cached for a `u` that the maximisation never visits again)
+    let jet = |u: f64, v: f64| {
+        let mut x = [[Vec3::ZERO; 6]];
+        s.seconds_at(&[[u, v]], &mut x);
+        // `ds` by index a·3 + b of ∂ᵃ_u ∂ᵇ_v
+        let ds = b.derivatives(u, v, 2, 2);
+        let x = x[0];
+        let e = [ds[0] - x[0], ds[3] - x[1], ds[1] - x[2], ds[6] - x[3], ds[4] - x[4], ds[2] - x[5]];
+        (e, x[0].scaled_norm())
+    };
     let point = |u: f64, v: f64| {
         let mut x = [Vec3::ZERO];
         s.points_at(&[[u, v]], &mut x);
-        x[0]
+        (b.point(u, v) - x[0]).scaled_norm()
     };
-    let f = |u: f64, v: f64| (b.point(u, v) - point(u, v)).scaled_norm();
+    // the relative growth below which |e| is taken as converged
+    let floor = |f: f64, x: f64| crate::num::max_nan(5e-10, 16.0 * f64::EPSILON * (x / f));
+    let (wu, wv) = (ru.1 - ru.0, rv.1 - rv.0);
     let (mut u, mut v) = (u0, v0);
-    let mut fv = f(u, v);
-    let mut step = 0.25 * (ru.1 - ru.0).max(rv.1 - rv.0);
+    let (mut e, mut xn) = jet(u, v);
     let mut evals = 1;
+    let mut fv = e[0].scaled_norm();
+    let mut step = 0.25 * wu.max(wv);
     for _ in 0..30 {
-        let ds = b.derivatives(u, v, 1, 1);
-        let mut dx = [[Vec3::ZERO; 3]];
-        s.firsts_at(&[[u, v]], &mut dx);
-        // the gradient of |e| is ê·e_u, ê·e_v (ê the unit error); `ds` by index a·2 + b:
-        // [S, S_v, S_u, S_uv], `dx`: [X, X_u, X_v]
-        let dx = [dx[0][0], dx[0][2], dx[0][1]];
-        let e = ds[0] - dx[0];
-        let n = e.scaled_norm();
+        let n = fv;
         if !(n > 0.0 && n.is_finite()) {
             break;
         }
-        let e = e / n;
-        let (gu, gv) = (e.dot(ds[2] - dx[2]), e.dot(ds[1] - dx[1]));
-        // only the gradient's direction is used: scaled to its largest component so that
-        // its square neither underflows (a patch at 1e-160) nor overflows (at 1e160)
-        let m = crate::num::max_nan(gu.abs(), gv.abs());
-        if !(m > 0.0 && m.is_finite()) {
-            break;
-        }
-        let (gu, gv) = (gu / m, gv / m);
-        let g = (gu * gu * (ru.1 - ru.0).powi(2) + gv * gv * (rv.1 - rv.0).powi(2)).sqrt();
-        if g.is_nan() || g == 0.0 {
-            break;
-        }
-        let mut moved = false;
-        while step > 1e-6 * (ru.1 - ru.0) {
-            let nu = (u + step * gu * (ru.1 - ru.0).powi(2) / g).clamp(ru.0, ru.1);
-            let nv = (v + step * gv * (rv.1 - rv.0).powi(2) / g).clamp(rv.0, rv.1);
-            let fnew = f(nu, nv);
+        let tol = floor(fv, xn);
+        let d = e.map(|x| x / n);
+        let g = [d[0].dot(d[1]), d[0].dot(d[2])];
+        // the Hessian of ψ (with |d| = 1): ∇²φ − 2 ∇φ ∇φᵀ
+        let h = [
+            d[1].dot(d[1]) + d[0].dot(d[3]) - 2.0 * g[0] * g[0],
+            d[1].dot(d[2]) + d[0].dot(d[4]) - 2.0 * g[0] * g[1],
+            d[2].dot(d[2]) + d[0].dot(d[5]) - 2.0 * g[1] * g[1],
+        ];
+        // the coordinates held at a side of the cell (the gradient pointing out of it)
+        let held = |x: f64, (lo, hi): (f64, f64), gx: f64| (x <= lo && gx < 0.0) || (x >= hi && gx > 0.0);
+        let newton = match (held(u, ru, g[0]), held(v, rv, g[1])) {
+            (true, true) => Some([0.0, 0.0]),
+            (false, false) => {
+                let det = h[0] * h[2] - h[1] * h[1];
+                (h[0] < 0.0 && det > 0.0)
+                    .then(|| [-(h[2] * g[0] - h[1] * g[1]) / det, -(h[0] * g[1] - h[1] * g[0]) / det])
+            }
+            (false, true) => (h[0] < 0.0).then(|| [-g[0] / h[0], 0.0]),
+            (true, false) => (h[2] < 0.0).then(|| [0.0, -g[1] / h[2]]),
+        };
+        // the next point and whether |e| grew there by more than `tol` of itself
+        let mut next: Option<(f64, f64, bool)> = None;
+        if let Some(dx) = newton.filter(|dx| dx.iter().all(|x| x.is_finite())) {
+            // P: the growth of ψ the full step promises (∇ψ = g: the scaled quantities are
+            // already divided by |e|)
+            let p = 0.5 * (g[0] * dx[0] + g[1] * dx[1]);
+            if p.partial_cmp(&tol) != Some(std::cmp::Ordering::Greater) {
+                break; // converged (or a corner of the cell that the gradient leaves)
+            }
+            let (nu, nv) = ((u + dx[0]).clamp(ru.0, ru.1), (v + dx[1]).clamp(rv.0, rv.1));
+            let (en, xnew) = jet(nu, nv);
             evals += 1;
+            let fnew = en[0].scaled_norm();
             if fnew > fv {
-                // converged when the deviation grows by less than 5e-10 of itself (its
-                // square by less than 1e-9)
-                moved = fnew - fv > 5e-10 * fnew;
-                (u, v, fv) = (nu, nv, fnew);
-                step *= 1.5;
+                let moved = fnew - fv > tol * fnew;
+                (u, v, e, xn, fv) = (nu, nv, en, xnew, fnew);
+                if !moved {
+                    break;
+                }
+                continue;
+            }
+            let mut t = 0.5;
+            while p * t * (2.0 - t) > tol {
+                if t < 0.1 {
+                    break;
+                }
+                let (nu, nv) = ((u + t * dx[0]).clamp(ru.0, ru.1), (v + t * dx[1]).clamp(rv.0, rv.1));
+                let fnew = point(nu, nv);
+                evals += 1;
+                if fnew > fv {
+                    next = Some((nu, nv, fnew - fv > tol * fnew));
+                    break;
+                }
+                t *= 0.5;
+            }
+            if next.is_none() && p * t * (2.0 - t) <= tol {
+                break; // what is left to gain is below the stopping rule
+            }
+        }
+        if next.is_none() {
+            // a gradient step: only the gradient's direction is used, scaled to its
+            // largest component so that its square neither underflows nor overflows
+            let m = crate::num::max_nan(g[0].abs(), g[1].abs());
+            if !(m > 0.0 && m.is_finite()) {
                 break;
             }
-            step *= 0.5;
+            let (gu, gv) = (g[0] / m, g[1] / m);
+            let gn = (gu * gu * wu * wu + gv * gv * wv * wv).sqrt();
+            if gn.is_nan() || gn == 0.0 {
+                break;
+            }
+            while step > 1e-6 * wu {
+                let nu = (u + step * gu * wu * wu / gn).clamp(ru.0, ru.1);
+                let nv = (v + step * gv * wv * wv / gn).clamp(rv.0, rv.1);
+                let fnew = point(nu, nv);
+                evals += 1;
+                if fnew > fv {
+                    next = Some((nu, nv, fnew - fv > tol * fnew));
+                    step *= 1.5;
+                    break;
+                }
+                step *= 0.5;
+            }
         }
+        let Some((nu, nv, moved)) = next else { break };
+        (u, v) = (nu, nv);
+        (e, xn) = jet(u, v);
+        evals += 1;
+        fv = e[0].scaled_norm();
         if !moved {
             break;
         }

@@ -92,6 +92,16 @@ pub trait Surface: Send + Sync {
         }
     }
 
+    /// `out[p] = [X, X_u, X_v, X_uu, X_uv, X_vv]` (the order of [`jet2`](Self::jet2)) at
+    /// scattered parameters `uv[p] = [u, v]`, on the calling thread; as
+    /// [`points_at`](Self::points_at), with first and second derivatives.
+    fn seconds_at(&self, uv: &[[f64; 2]], out: &mut [[Vec3; 6]]) {
+        assert_eq!(uv.len(), out.len(), "one output per point");
+        for (o, p) in out.iter_mut().zip(uv) {
+            *o = self.jet2(p[0], p[1]);
+        }
+    }
+
     /// Values `X` on the grid `us × vs` (row-major in `u`): the first of [`grid`](Self::grid)'s
     /// four, for callers that need no derivatives (the fit's samples); solvers whose grids
     /// are matrix products override it to form the values' product alone.

@@ -32,8 +32,13 @@ use crate::taylor::Taylor;
 /// Points per block: the data are evaluated for a block at once.
 const BLOCK: usize = 256;
 
-/// Highest `u`-derivative folded.
+/// Highest `u`-derivative folded for values and first derivatives.
 pub(super) const KMAX: usize = 1;
+
+/// Highest `u`-derivative of the second folding, made on the first call that asks for
+/// second derivatives (a local maximisation's Newton steps): the first keeps its tables
+/// and its cost, and its numbers do not depend on whether seconds were ever asked for.
+pub(super) const KMAX2: usize = 2;
 
 /// Every mode's `(A_n, B_n)` and the remainder's cardinal functions, folded.
 pub(super) struct Folded {
@@ -81,7 +86,7 @@ fn joint_taylor<const N: usize>(tape: &Tape, at: &[f64], blk: usize, g: &mut [Ve
 }
 
 impl Folded {
-    pub(super) fn new(p: &SpectralPatch) -> Folded {
+    pub(super) fn new(p: &SpectralPatch, kmax: usize) -> Folded {
         let nc = p.conds.len();
         let modes = p
             .cards
@@ -96,11 +101,11 @@ impl Folded {
                         [a.x, a.y, a.z, b.x, b.y, b.z]
                     })
                     .collect();
-                Combined::new(card, w, 6, KMAX)
+                Combined::new(card, w, 6, kmax)
             })
             .collect();
         let eye: Vec<f64> = (0..nc * nc).map(|k| f64::from(k / nc == k % nc)).collect();
-        let rem = p.rem.as_ref().map(|r| Combined::new(r, eye, nc, KMAX));
+        let rem = p.rem.as_ref().map(|r| Combined::new(r, eye, nc, kmax));
         Folded { modes, rem, joint: joint_tape(&p.data) }
     }
 }
@@ -127,8 +132,13 @@ fn npow(n: usize, j: usize) -> f64 {
 }
 
 impl SpectralPatch {
-    fn folded(&self) -> &Folded {
-        self.folded.get_or_init(|| Folded::new(self))
+    /// The folding for `u`-derivatives up to `imax` (at most [`KMAX2`]).
+    fn folded(&self, imax: usize) -> &Folded {
+        if imax <= KMAX {
+            self.folded.get_or_init(|| Folded::new(self, KMAX))
+        } else {
+            self.folded2.get_or_init(|| Folded::new(self, KMAX2))
+        }
     }
 
     /// `out[p][d] = ∂^{i+j}X/∂uⁱ∂vʲ (uv[p])` for `(i, j) = orders[d]`, `i ≤ 1`, on the
@@ -142,8 +152,8 @@ impl SpectralPatch {
         assert_eq!(uv.len(), out.len(), "one output per point");
         let imax = orders.iter().map(|o| o.0).max().unwrap_or(0);
         let jmax = orders.iter().map(|o| o.1).max().unwrap_or(0);
-        assert!(imax <= KMAX, "u-derivatives up to {KMAX} at scattered points");
-        let f = self.folded();
+        assert!(imax <= KMAX2, "u-derivatives up to {KMAX2} at scattered points");
+        let f = self.folded(imax);
         let (m, nc, nj) = (self.kept, self.conds.len(), jmax + 1);
         let a = self.opts.a;
         let scratch_len = f.modes.iter().chain(&f.rem).map(Combined::scratch_len).max().unwrap_or(0);
@@ -320,21 +330,28 @@ mod tests {
     }
 
     /// Largest `|batched − pointwise|` over the points relative to the largest
-    /// `|pointwise|`, for the value, `X_u` and `X_v`.
-    fn agreement(p: &SpectralPatch, uv: &[[f64; 2]]) -> [f64; 3] {
+    /// `|pointwise|`, for the value, `X_u`, `X_v` (from `firsts_at`) and `X_uu`, `X_uv`,
+    /// `X_vv` (from `seconds_at`, whose value and first derivatives count too).
+    fn agreement(p: &SpectralPatch, uv: &[[f64; 2]]) -> [f64; 6] {
         let mut vals = vec![Vec3::ZERO; uv.len()];
         p.points_at(uv, &mut vals);
         let mut firsts = vec![[Vec3::ZERO; 3]; uv.len()];
         p.firsts_at(uv, &mut firsts);
-        let mut err = [0.0; 3];
-        let mut size = [0.0; 3];
+        let mut seconds = vec![[Vec3::ZERO; 6]; uv.len()];
+        p.seconds_at(uv, &mut seconds);
+        let mut err = [0.0; 6];
+        let mut size = [0.0; 6];
         for (k, q) in uv.iter().enumerate() {
-            let d = p.derivatives(q[0], q[1], 1, 1);
-            let want = [d[0], d[2], d[1]];
+            // index i·3 + j of ∂ⁱ_u ∂ʲ_v
+            let d = p.derivatives(q[0], q[1], 2, 2);
+            let want = [d[0], d[3], d[1], d[6], d[4], d[2]];
             // the values alone and with derivatives: the same sums
             err[0] = max_nan(err[0], (vals[k] - firsts[k][0]).norm());
-            for c in 0..3 {
-                err[c] = max_nan(err[c], (firsts[k][c] - want[c]).norm());
+            for c in 0..6 {
+                if c < 3 {
+                    err[c] = max_nan(err[c], (firsts[k][c] - want[c]).norm());
+                }
+                err[c] = max_nan(err[c], (seconds[k][c] - want[c]).norm());
                 size[c] = max_nan(size[c], want[c].norm());
             }
         }
@@ -376,7 +393,7 @@ mod tests {
             paths.extend(report.mode_paths.iter().copied());
             let us: Vec<f64> = p.conds.iter().map(|c| c.u).collect();
             let e = agreement(p, &points(10_000, p.v_domain(), &us));
-            for (what, e) in ["value", "X_u", "X_v"].iter().zip(e) {
+            for (what, e) in ["value", "X_u", "X_v", "X_uu", "X_uv", "X_vv"].iter().zip(e) {
                 // the same products summed in another order (the modes' exponentials as
                 // products, cos nθ by rotations): a few ulps; 2.6e-15 seen at most
                 assert!(e <= 1e-14, "{name}: {what} differs by {e:e} (relative)");

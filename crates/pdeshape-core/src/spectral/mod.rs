@@ -110,6 +110,8 @@ pub struct SpectralPatch {
     cache: BoundedMemo<(u64, usize), Arc<Row>>,
     /// The modes folded for scattered points ([`batch`]), on first use.
     folded: OnceLock<batch::Folded>,
+    /// The same with second `u`-derivatives, on the first call that asks for them.
+    folded2: OnceLock<batch::Folded>,
     /// Every datum is proved a trigonometric polynomial of degree ≤ M in θ
     /// ([`crate::expr::trig_degree`]) on a periodic patch, independent of `t`: its Fourier
     /// series of M modes is the datum itself (analysed from more than 2M samples, so
@@ -316,6 +318,7 @@ impl SpectralPatch {
             time: 0.0,
             cache: BoundedMemo::new(4096),
             folded: OnceLock::new(),
+            folded2: OnceLock::new(),
             exact: degrees.iter().map(Option::is_some).collect(),
             exact_series,
             data,
@@ -630,6 +633,10 @@ impl Surface for SpectralPatch {
 
     fn firsts_at(&self, uv: &[[f64; 2]], out: &mut [[Vec3; 3]]) {
         self.scattered(uv, [(0, 0), (1, 0), (0, 1)], out);
+    }
+
+    fn seconds_at(&self, uv: &[[f64; 2]], out: &mut [[Vec3; 6]]) {
+        self.scattered(uv, [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)], out);
     }
 
     fn grid(&self, us: &[f64], vs: &[f64]) -> Vec<[Vec3; 4]> {
