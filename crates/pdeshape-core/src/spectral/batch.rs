@@ -112,7 +112,7 @@ impl Folded {
 
 /// `(cos, sin)(φ + jπ/2)` from `(cos φ, sin φ)`: a quarter turn per order.
 #[inline]
-fn turn((c, s): (f64, f64), j: usize) -> (f64, f64) {
+pub(super) fn turn((c, s): (f64, f64), j: usize) -> (f64, f64) {
     match j % 4 {
         0 => (c, s),
         1 => (-s, c),

@@ -702,39 +702,41 @@ impl SpectralPatch {
         let m = self.kept;
         let tailc: Vec<usize> = (0..self.conds.len()).filter(|&c| !self.exact[c]).collect();
         let width = 1 + 2 * m + tailc.len();
+        // R and Q written row by row and column by column (each row's and column's data
+        // read once; the same numbers as entry by entry)
         let r_mat = |i: usize, x: usize| {
-            Mat::<f64>::from_fn(nu, width, |ui, f| {
-                let row = &rows[ui];
-                match f {
-                    0 => row.a[i][0][x],
-                    f if f <= m => row.a[i][f][x],
-                    f if f <= 2 * m => row.b[i][f - m][x],
-                    f => row.l[i][tailc[f - 1 - 2 * m]],
+            let mut r = Mat::<f64>::zeros(nu, width);
+            for (ui, row) in rows.iter().enumerate() {
+                let (a, b, l) = (&row.a[i], &row.b[i], &row.l[i]);
+                r[(ui, 0)] = a[0][x];
+                for n in 1..=m {
+                    r[(ui, n)] = a[n][x];
+                    r[(ui, m + n)] = b[n][x];
                 }
-            })
+                for (k, &c) in tailc.iter().enumerate() {
+                    r[(ui, 2 * m + 1 + k)] = l[c];
+                }
+            }
+            r
         };
         let q_mat = |j: usize, x: usize| {
             let k = self.dtheta_dv.powi(j as i32);
-            Mat::<f64>::from_fn(width, nv, |f, vi| {
-                let col = &cols[vi];
-                let trig = |n: usize, sine: bool| {
+            let mut q = Mat::<f64>::zeros(width, nv);
+            for (vi, col) in cols.iter().enumerate() {
+                let dst = q.col_as_slice_mut(vi);
+                dst[0] = k * f64::from(j == 0);
+                for n in 1..=m {
                     // ∂θʲ (cos nθ, sin nθ) = nʲ (cos, sin)(nθ + jπ/2): a quarter turn per order
-                    let (c, s) = col.cs[n];
-                    let (c, s) = match j % 4 {
-                        0 => (c, s),
-                        1 => (-s, c),
-                        2 => (-c, -s),
-                        _ => (s, -c),
-                    };
-                    (n as f64).powi(j as i32) * if sine { s } else { c }
-                };
-                k * match f {
-                    0 => f64::from(j == 0),
-                    f if f <= m => trig(f, false),
-                    f if f <= 2 * m => trig(f - m, true),
-                    f => col.tails[tailc[f - 1 - 2 * m]][j][x],
+                    let (c, s) = batch::turn(col.cs[n], j);
+                    let nj = (n as f64).powi(j as i32);
+                    dst[n] = k * (nj * c);
+                    dst[m + n] = k * (nj * s);
                 }
-            })
+                for (t, &c) in tailc.iter().enumerate() {
+                    dst[2 * m + 1 + t] = k * col.tails[c][j][x];
+                }
+            }
+            q
         };
         // R and Q once per order and component; the products transposed (`Pᵀ = Qᵀ Rᵀ`, a
         // column per `u`) so that each grid row is read as a contiguous column.
