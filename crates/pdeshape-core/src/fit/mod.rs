@@ -266,20 +266,26 @@ fn fit_on(s: &dyn Surface, ku: &Knots, kv: &Knots) -> Result<BSplineSurface, Fit
     let nu = gu.len();
     let mut rows: Vec<(f64, usize)> = gu.iter().map(|&u| (u, 0)).collect();
     if nu >= 4 {
-        let ends = s.grid(&[0.0, 1.0], &gv);
+        // degree ≥ 5: the next rows interpolate X_uu too, so that faces meeting along an
+        // edge share their curvature across it as well (C2 / G2 survives the export); one
+        // evaluation of the ends then gives both (`grid2`'s X_u is `grid`'s, the same
+        // products)
+        let second = ku.degree >= 5 && nu >= 6;
+        let ends: Vec<[Vec3; 2]> = if second {
+            s.grid2(&[0.0, 1.0], &gv).into_iter().map(|x| [x[1], x[3]]).collect()
+        } else {
+            s.grid(&[0.0, 1.0], &gv).into_iter().map(|x| [x[1], Vec3::ZERO]).collect()
+        };
         let nv = gv.len();
         rows[1] = (0.0, 1);
         rows[nu - 2] = (1.0, 1);
-        samples[1] = ends[..nv].iter().map(|x| x[1]).collect();
-        samples[nu - 2] = ends[nv..].iter().map(|x| x[1]).collect();
-        // degree ≥ 5: the next rows interpolate X_uu too, so that faces meeting along an
-        // edge share their curvature across it as well (C2 / G2 survives the export)
-        if ku.degree >= 5 && nu >= 6 {
-            let ends = s.grid2(&[0.0, 1.0], &gv);
+        samples[1] = ends[..nv].iter().map(|x| x[0]).collect();
+        samples[nu - 2] = ends[nv..].iter().map(|x| x[0]).collect();
+        if second {
             rows[2] = (0.0, 2);
             rows[nu - 3] = (1.0, 2);
-            samples[2] = ends[..nv].iter().map(|x| x[3]).collect();
-            samples[nu - 3] = ends[nv..].iter().map(|x| x[3]).collect();
+            samples[2] = ends[..nv].iter().map(|x| x[1]).collect();
+            samples[nu - 3] = ends[nv..].iter().map(|x| x[1]).collect();
         }
     }
     for (i, row) in samples.iter().enumerate() {
