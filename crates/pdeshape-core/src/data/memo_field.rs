@@ -121,30 +121,13 @@ impl Field for MemoField {
 mod tests {
     use super::*;
     use crate::data::ExprField;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-
-    /// Counts the inner field's evaluations.
-    #[derive(Debug)]
-    struct Counted(ExprField, AtomicUsize);
-    impl Field for Counted {
-        fn arity(&self) -> usize {
-            2
-        }
-        fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
-            self.1.fetch_add(1, Ordering::Relaxed);
-            self.0.jet(at, shape)
-        }
-        fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
-            self.1.fetch_add(1, Ordering::Relaxed);
-            self.0.derivatives_in(at, slot, out)
-        }
-    }
+    use crate::data::tests::Counted;
 
     /// The same bits as the inner field, which is asked once per point, slot and order.
     #[test]
     fn values_are_the_inner_fields_and_asked_once() {
         let e = ExprField::parse(["cos(3*v)", "sin(v)*t", "v*v"], &["v", "t"], &|_| None).unwrap();
-        let inner = Arc::new(Counted(e.clone(), AtomicUsize::new(0)));
+        let inner = Arc::new(Counted::new(e.clone()));
         let m = MemoField::new(inner.clone());
         for _ in 0..3 {
             for v in [0.1, 0.7, 2.0] {
@@ -156,7 +139,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(inner.1.load(Ordering::Relaxed), 6);
+        assert_eq!(inner.count(), 6);
         for _ in 0..3 {
             for v in [0.1, 0.7] {
                 for shape in [JetShape::new(&[2, 1]), JetShape::new(&[1, 1])] {
@@ -164,7 +147,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(inner.1.load(Ordering::Relaxed), 10, "each jet asked once per point and shape");
+        assert_eq!(inner.count(), 10, "each jet asked once per point and shape");
     }
 
     /// Covering: each point's jet computed once, in the covering shape; smaller shapes and
@@ -173,7 +156,7 @@ mod tests {
     #[test]
     fn covering_cuts_smaller_jets_from_one() {
         let e = ExprField::parse(["cos(3*v)*exp(t)", "sin(v)*t*t", "v*v/(1+t*t)"], &["v", "t"], &|_| None).unwrap();
-        let inner = Arc::new(Counted(e.clone(), AtomicUsize::new(0)));
+        let inner = Arc::new(Counted::new(e.clone()));
         let m = MemoField::covering(inner.clone(), JetShape::new(&[2, 3]));
         let points = [[0.1, 0.5], [0.7, -0.2], [2.0, 1.3]];
         for _ in 0..2 {
@@ -200,10 +183,10 @@ mod tests {
                 }
             }
         }
-        assert_eq!(inner.1.load(Ordering::Relaxed), points.len(), "one jet a point");
+        assert_eq!(inner.count(), points.len(), "one jet a point");
         // beyond the cover: the inner field's own, bit for bit
         let big = JetShape::new(&[3, 1]);
         assert_eq!(m.jet(&points[0], big), e.jet(&points[0], big));
-        assert_eq!(inner.1.load(Ordering::Relaxed), points.len() + 1);
+        assert_eq!(inner.count(), points.len() + 1);
     }
 }

@@ -264,6 +264,36 @@ pub(crate) mod tests {
     use super::fourier::{FourierSeries, sample_count};
     use super::*;
     use proptest::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// An expression field that counts its evaluations (jets and `derivatives_in` calls).
+    #[derive(Debug)]
+    pub(crate) struct Counted(pub(crate) ExprField, pub(crate) AtomicUsize);
+
+    impl Counted {
+        pub(crate) fn new(e: ExprField) -> Self {
+            Counted(e, AtomicUsize::new(0))
+        }
+
+        /// Evaluations so far.
+        pub(crate) fn count(&self) -> usize {
+            self.1.load(Ordering::Relaxed)
+        }
+    }
+
+    impl Field for Counted {
+        fn arity(&self) -> usize {
+            self.0.arity()
+        }
+        fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
+            self.1.fetch_add(1, Ordering::Relaxed);
+            self.0.jet(at, shape)
+        }
+        fn derivatives_in(&self, at: &[f64], slot: usize, out: &mut [Vec3]) {
+            self.1.fetch_add(1, Ordering::Relaxed);
+            self.0.derivatives_in(at, slot, out)
+        }
+    }
 
     /// Checks a claimed [`Field::trig_degree`] `d` independently: the DFT of `f` at
     /// `8 (d + 1)` points of slot 0 (enough that nothing aliases) has no coefficient above

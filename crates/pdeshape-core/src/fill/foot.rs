@@ -265,21 +265,8 @@ impl Field for FootCurve {
 mod tests {
     use super::*;
     use crate::data::ExprField;
+    use crate::data::tests::Counted;
     use std::sync::Arc;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-
-    /// Counts the surface's jets.
-    #[derive(Debug)]
-    struct Counted(Arc<ExprField>, AtomicUsize);
-    impl Field for Counted {
-        fn arity(&self) -> usize {
-            3
-        }
-        fn jet(&self, at: &[f64], shape: JetShape) -> VecJet {
-            self.1.fetch_add(1, Ordering::Relaxed);
-            self.0.jet(at, shape)
-        }
-    }
 
     /// A helix on a cylinder of radius 2 whose foot curve is known in closed form:
     /// `C(τ) = (2 cos τ², 2 sin τ², τ³)` on `S(u, v) = (2 cos u, 2 sin u, v)` has
@@ -326,10 +313,10 @@ mod tests {
     /// checked).
     #[test]
     fn the_walk_predicts_each_foot() {
-        let host = Arc::new(ExprField::parse(["2*cos(u)", "2*sin(u)", "v"], &["u", "v", "t"], &|_| None).unwrap());
+        let host = ExprField::parse(["2*cos(u)", "2*sin(u)", "v"], &["u", "v", "t"], &|_| None).unwrap();
         let curve =
             Arc::new(ExprField::parse(["2.001*cos(s*s)", "2.001*sin(s*s)", "s*s*s"], &["s"], &|_| None).unwrap());
-        let counted = Arc::new(Counted(host, AtomicUsize::new(0)));
+        let counted = Arc::new(Counted::new(host));
         let f = FootCurve::new(counted.clone(), curve, (0.5, 2.5), [0.25, 0.1], 0.0).unwrap();
         assert!((f.max_distance() - 1e-3).abs() < 1e-14, "{}", f.max_distance());
         assert_eq!(f.seeds.len(), 129);
@@ -338,7 +325,7 @@ mod tests {
             let tol = 4.0 * f64::EPSILON * (1.0 + tau.powi(3));
             assert!((c[0] - tau * tau).abs() < tol && (c[1] - tau.powi(3)).abs() < tol, "{tau}: {c:?}");
         }
-        let jets = counted.1.load(Ordering::Relaxed);
+        let jets = counted.count();
         assert!(jets <= 4 * 129, "{jets} jets of the surface for 129 feet");
     }
 }
