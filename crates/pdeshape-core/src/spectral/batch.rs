@@ -88,22 +88,8 @@ fn joint_taylor<const N: usize>(tape: &Tape, at: &[f64], blk: usize, g: &mut [Ve
 impl Folded {
     pub(super) fn new(p: &SpectralPatch, kmax: usize) -> Folded {
         let nc = p.conds.len();
-        let modes = p
-            .cards
-            .iter()
-            .enumerate()
-            .map(|(m, card)| {
-                let w: Vec<f64> = p
-                    .series
-                    .iter()
-                    .flat_map(|s| {
-                        let (a, b) = (s.a[m], s.b[m]);
-                        [a.x, a.y, a.z, b.x, b.y, b.z]
-                    })
-                    .collect();
-                Combined::new(card, w, 6, kmax)
-            })
-            .collect();
+        let modes =
+            p.cards.iter().enumerate().map(|(m, card)| Combined::new(card, p.mode_weights(m), 6, kmax)).collect();
         let eye: Vec<f64> = (0..nc * nc).map(|k| f64::from(k / nc == k % nc)).collect();
         let rem = p.rem.as_ref().map(|r| Combined::new(r, eye, nc, kmax));
         Folded { modes, rem, joint: joint_tape(&p.data) }
