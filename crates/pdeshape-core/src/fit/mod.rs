@@ -314,24 +314,31 @@ fn spline_grid(b: &BSplineSurface, us: &[f64], vs: &[f64]) -> Vec<Vec3> {
     let mut vw = vec![0.0; vs.len() * (q + 1)];
     let vspan: Vec<usize> = vs.iter().zip(vw.chunks_mut(q + 1)).map(|(&v, w)| b.v.values_into(v, w)).collect();
     let mut out = Vec::with_capacity(us.len() * vs.len());
-    let mut row = vec![Vec3::ZERO; nv];
+    // the row's components apart, and sums in named locals: with `Vec3` accumulators the
+    // loops kept them in memory (the same sums in the same order, so the same numbers)
+    let mut row = vec![[0.0f64; 3]; nv];
     let mut uw = vec![0.0; p + 1];
     for &u in us {
         let su = b.u.values_into(u, &mut uw);
-        row.iter_mut().for_each(|x| *x = Vec3::ZERO);
+        row.fill([0.0; 3]);
         for (r, &w) in uw.iter().enumerate() {
-            let base = (su - p + r) * nv;
-            for (j, x) in row.iter_mut().enumerate() {
-                *x += b.control[base + j] * w;
+            let net = &b.control[(su - p + r) * nv..][..nv];
+            for (x, c) in row.iter_mut().zip(net) {
+                x[0] += c.x * w;
+                x[1] += c.y * w;
+                x[2] += c.z * w;
             }
         }
-        for (sv, w) in vspan.iter().zip(vw.chunks(q + 1)) {
-            let mut x = Vec3::ZERO;
-            for (c, &wc) in w.iter().enumerate() {
-                x += row[sv - q + c] * wc;
+        // a trusted-length iterator: no capacity check per point, no zeroing first
+        out.extend(vspan.iter().zip(vw.chunks_exact(q + 1)).map(|(&sv, w)| {
+            let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+            for (a, &wc) in row[sv - q..=sv].iter().zip(w) {
+                x += a[0] * wc;
+                y += a[1] * wc;
+                z += a[2] * wc;
             }
-            out.push(x);
-        }
+            Vec3::new(x, y, z)
+        }));
     }
     out
 }
