@@ -109,10 +109,32 @@ impl Cardinal {
     }
 
     /// `out[k][i] = ℓ_i^{(k)}(u)` for `k = 0 … kmax`.
+    ///
+    /// At a condition's own place and order the row is the exact unit vector the cardinal
+    /// property defines, `ℓ_i^{(k_c)}(u_c) = δ_ic`, as the tabulated sets store theirs: the
+    /// sums in f64 carry `φ^{(k)}`'s size (`ω⁹ ≈ 4e7` for a ninth derivative at `ω = 7`)
+    /// times the coefficients' round-off, and a ninth-derivative condition then held to
+    /// 3e-10 only.
     pub fn eval(&self, u: f64, kmax: usize) -> Vec<Vec<f64>> {
         let d = self.space.derivatives(u, kmax);
         let n = self.space.dim();
-        d.iter().map(|row| (0..n).map(|i| (0..n).map(|b| row[b] * self.coef[(b, i)]).sum()).collect()).collect()
+        let mut out: Vec<Vec<f64>> =
+            d.iter().map(|row| (0..n).map(|i| (0..n).map(|b| row[b] * self.coef[(b, i)]).sum()).collect()).collect();
+        for (c, cd) in self.conds.iter().enumerate() {
+            if cd.u == u && cd.order <= kmax {
+                out[cd.order] = (0..n).map(|i| f64::from(i == c)).collect();
+            }
+        }
+        out
+    }
+
+    /// The places of the conditions, sorted, each once: where [`eval`](Self::eval) answers
+    /// rows of the cardinal property itself.
+    pub fn condition_places(&self) -> Vec<f64> {
+        let mut at: Vec<f64> = self.conds.iter().map(|c| c.u).collect();
+        at.sort_by(f64::total_cmp);
+        at.dedup();
+        at
     }
 
     /// The 2-norm condition number of the condition matrix in the bounded basis, rows and

@@ -22,7 +22,8 @@
 //! through its combination too ([`Combined::polynomial`]), so there both paths give the
 //! same numbers.
 //!
-//! Where the set answers from stored rows (the Chebyshev forms at their condition points)
+//! Where the set answers from stored rows (every form at its conditions' places, where
+//! the rows are the cardinal property's own)
 //! or its basis has no closed form here (clustered roots, piecewise multiple-precision
 //! tables), the combination falls back to [`CardinalSet::eval`] and the weights.
 
@@ -188,7 +189,8 @@ impl Combined {
                     }
                     _ => Kind::Generic,
                 };
-                (kind, Vec::new())
+                // at the conditions' places the set answers the cardinal property's rows
+                (kind, card.condition_places())
             }
             CardinalSet::Ultraspherical(card) if card.kmax() >= kmax => {
                 let size = card.terms();
@@ -468,7 +470,9 @@ mod tests {
         };
         let mut pts: Vec<f64> = (0..60).map(|_| next()).collect();
         pts.extend((0..20).map(|_| 1.0 - 1e-3 * next()));
-        pts.extend([0.0, 1.0, us[5]]);
+        // beside the conditions' places (there the set's own rows answer, `δ_ic` at a
+        // condition's order)
+        pts.extend([1e-9, 1.0 - 1e-9, us[5] + 1e-9]);
         let kmax = 3;
         let mut scratch = vec![0.0; comb.scratch_len()];
         let mut out = vec![0.0; (kmax + 1) * 2];

@@ -367,3 +367,27 @@ fn data_proved_finite_series_have_no_remainder() {
     // second derivatives ≤ ~40 here: a few ulps of them
     assert!(worst < 1e-12, "grids and batches differ by {worst:e}");
 }
+
+/// A case the property test above found with a random seed: position and derivatives
+/// 1–9 at `u = 0`, position and slope at `u = 1`, `a = 1.74`. The remainder's cardinal functions (`ω = 7`, solved in f64) summed `φ^{(9)}(0) C` with
+/// `|φ^{(9)}| ≈ 4e7`: the ninth- and eighth-derivative conditions held to 3.3e-10 and
+/// 1.1e-10 only. At a condition's own place and order the rows are now the cardinal
+/// property's unit vectors.
+#[test]
+fn ninth_derivative_conditions_hold() {
+    let mut seeds = vec![0.0; 40];
+    seeds[5] = -0.4026662318415399;
+    let mut specs = vec![(0.0, 0), (1.0, 0)];
+    specs.extend((1..=9).map(|d| (0.0, d)));
+    specs.push((1.0, 1));
+    let conds: Vec<Condition> = specs
+        .iter()
+        .enumerate()
+        .map(|(i, &(u, d))| Condition { u, order: d, data: random_curve(&seeds[i..i + 3]) })
+        .collect();
+    let opts = SpectralOptions { a: 1.7404181942342378, modes: 3, omega: None };
+    let p = SpectralPatch::new(&conds, VDomain::PERIODIC, opts).expect("solves");
+    let rep = check_conditions(&p, &conds, 0.0, 1000);
+    // each condition is then its datum's Fourier sum and tail added back: a few ulps (0 seen)
+    assert!(rep.max_rel <= 1e-14, "error {:e}", rep.max_rel);
+}
