@@ -88,8 +88,16 @@ fn joint_taylor<const N: usize>(tape: &Tape, at: &[f64], blk: usize, g: &mut [Ve
 impl Folded {
     pub(super) fn new(p: &SpectralPatch, kmax: usize) -> Folded {
         let nc = p.conds.len();
-        let modes =
-            p.cards.iter().enumerate().map(|(m, card)| Combined::new(card, p.mode_weights(m), 6, kmax)).collect();
+        // mode 0, when polynomial, is the rows' own folding (every order already folded)
+        let modes = p
+            .cards
+            .iter()
+            .enumerate()
+            .map(|(m, card)| match p.poly0() {
+                Some(c) if m == 0 => c.clone(),
+                _ => Combined::new(card, p.mode_weights(m), 6, kmax),
+            })
+            .collect();
         let eye: Vec<f64> = (0..nc * nc).map(|k| f64::from(k / nc == k % nc)).collect();
         let rem = p.rem.as_ref().map(|r| Combined::new(r, eye, nc, kmax));
         Folded { modes, rem, joint: joint_tape(&p.data) }
