@@ -66,29 +66,50 @@ fn grid_mesh_in_pool(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
     // reference size of |X_u||X_v| for the degeneracy test: the median over at most
     // 4097 evenly strided vertices
     let reference = area_scale(flat.iter().map(|d| (d[1], d[2])));
-    if let Some(k) = flat.par_iter().position_first(|d| !d[0].is_finite()) {
+    // the first non-finite point in order: a plain scan (a parallel `position_first` shares
+    // its best index through an atomic read at every vertex, which cost more than the test)
+    if let Some(k) = flat.iter().position(|d| !d[0].is_finite()) {
         return Err(format!("the patch is not finite at (u, v) = ({}, {})", us[k / o.nv], vs[k % o.nv]));
     }
     let dom = s.v_domain();
     let u_mid = 0.5 * (o.u_range.0 + o.u_range.1);
     let v_mid = 0.5 * (dom.start + dom.end);
-    // normals in parallel by rows; the vertices where even the limit vanishes, in order
+    // normals, positions and UVs in parallel by rows (row and column from the loops, not
+    // from a division per vertex); the vertices where even the limit vanishes, in order
     let mut normals = vec![Vec3::ZERO; n];
+    let mut positions = vec![Vec3::ZERO; n];
+    let mut uvs = vec![[0.0; 2]; n];
+    let (fu, fv) = (1.0 / (o.nu - 1) as f64, 1.0 / (o.nv - 1) as f64);
+    let threshold = 1e-9 * reference;
     let missing: Vec<usize> = normals
         .par_chunks_mut(o.nv)
+        .zip(positions.par_chunks_mut(o.nv))
+        .zip(uvs.par_chunks_mut(o.nv))
         .zip(flat.par_chunks(o.nv))
         .enumerate()
-        .flat_map_iter(|(i, (dst, row))| {
+        .flat_map_iter(|(i, (((dst, pos), uv), row))| {
             crate::cancel::checkpoint();
             let mut gone = Vec::new();
-            for (j, (nm, d)) in dst.iter_mut().zip(row).enumerate() {
-                let [_, pu, pv, puv] = *d;
-                let mut nrm = pu.cross(pv);
-                if nrm.norm() <= 1e-9 * reference {
+            let ui = i as f64 * fu;
+            for (j, (((nm, p), t), d)) in dst.iter_mut().zip(pos.iter_mut()).zip(uv.iter_mut()).zip(row).enumerate() {
+                let [x, pu, pv, puv] = *d;
+                *p = x;
+                *t = [ui, j as f64 * fv];
+                let nrm = pu.cross(pv);
+                // one square root a vertex: the length that tests for a pole also scales
+                // the normal (`normalized` of a finite nonzero vector is `nrm / |nrm|`)
+                let len = nrm.norm();
+                if len > threshold && len.is_finite() {
+                    *nm = nrm / len;
+                    continue;
+                }
+                let nrm = if len <= threshold {
                     let side_u = if us[i] < u_mid { 1.0 } else { -1.0 };
                     let side_v = if vs[j] < v_mid { 1.0 } else { -1.0 };
-                    nrm = if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v };
-                }
+                    if pv.norm() <= pu.norm() { pu.cross(puv) * side_u } else { puv.cross(pv) * side_v }
+                } else {
+                    nrm
+                };
                 match nrm.normalized() {
                     Some(unit) => *nm = unit,
                     None => gone.push(i * o.nv + j),
@@ -97,9 +118,6 @@ fn grid_mesh_in_pool(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
             gone
         })
         .collect();
-    let positions: Vec<Vec3> = flat.par_iter().map(|d| d[0]).collect();
-    let (fu, fv) = (1.0 / (o.nu - 1) as f64, 1.0 / (o.nv - 1) as f64);
-    let uvs: Vec<[f64; 2]> = (0..n).into_par_iter().map(|k| [(k / o.nv) as f64 * fu, (k % o.nv) as f64 * fv]).collect();
     for &k in &missing {
         let (i, j) = (k / o.nv, k % o.nv);
         let mut acc = Vec3::ZERO;
@@ -112,15 +130,14 @@ fn grid_mesh_in_pool(s: &dyn Surface, o: &GridOptions) -> Result<Mesh, String> {
         normals[k] = acc.normalized().unwrap_or(Vec3::new(0.0, 0.0, 1.0));
     }
     // (u, v) → counter-clockwise about X_u × X_v
-    let quads: Vec<[u32; 4]> = (0..(o.nu - 1) * (o.nv - 1))
-        .into_par_iter()
-        .map(|q| {
-            let (i, j) = (q / (o.nv - 1), q % (o.nv - 1));
+    let mut quads = vec![[0u32; 4]; (o.nu - 1) * (o.nv - 1)];
+    quads.par_chunks_mut(o.nv - 1).enumerate().for_each(|(i, row)| {
+        for (j, q) in row.iter_mut().enumerate() {
             let a = (i * o.nv + j) as u32;
             let b = ((i + 1) * o.nv + j) as u32;
-            [a, b, b + 1, a + 1]
-        })
-        .collect();
+            *q = [a, b, b + 1, a + 1];
+        }
+    });
     Ok(Mesh { positions, normals, uvs, quads, grid: Some((o.nu, o.nv)), ..Default::default() })
 }
 
