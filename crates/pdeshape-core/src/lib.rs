@@ -25,6 +25,7 @@ pub mod expr;
 pub mod fill;
 pub mod fit;
 pub mod jet;
+pub mod lanes;
 pub mod limits;
 pub mod linalg;
 pub mod memo;

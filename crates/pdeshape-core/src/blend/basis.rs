@@ -145,7 +145,7 @@ pub fn decompose(
         let (x, _) = crate::linalg::least_squares(&g, &f, 1e12).map_err(|e| {
             BlendError::Basis(format!("the explicit basis functions are not independent on the domain ({e})"))
         })?;
-        let fit = &g * &x;
+        let fit = crate::lanes::after(&g * &x);
         for (c, cond) in conds.iter().enumerate() {
             let size = (0..vs.len()).fold(0.0f64, |m, i| m.max(f[(i, c)].abs()));
             let err = (0..vs.len()).fold(0.0f64, |m, i| m.max((fit[(i, c)] - f[(i, c)]).abs()));

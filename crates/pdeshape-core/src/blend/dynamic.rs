@@ -629,7 +629,7 @@ fn project(
         let f = Mat::from_fn(pts.len(), 3, |r, comp| c.data.eval(&[pts[r].0, pts[r].1])[comp]);
         let (x, _) = least_squares(&g, &f, 1e12)
             .map_err(|e| BlendError::Basis(format!("the explicit basis functions are not independent ({e})")))?;
-        let fit = &g * &x;
+        let fit = crate::lanes::after(&g * &x);
         let size = f.norm_max();
         let err = (&fit - &f).norm_max();
         if err > 1e-10 * size.max(1e-300) && err > 1e-14 {

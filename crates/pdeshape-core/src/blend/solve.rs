@@ -382,7 +382,7 @@ fn solve_collocation(
             nj * nb
         ))
     })?;
-    let res = &a * &x - &b;
+    let res = crate::lanes::after(&a * &x - &b);
     let rms = (res.squared_norm_l2() / rows as f64).sqrt();
     let profiles = (0..nj)
         .map(|j| Profile::Poly {

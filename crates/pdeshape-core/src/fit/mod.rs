@@ -238,7 +238,7 @@ fn interpolate(k: &Knots, xs: &[(f64, usize)], rhs: &[Vec<Vec3>]) -> Result<Vec<
             b[(row, span - k.degree + r)] = w;
         }
     }
-    let lu = b.partial_piv_lu();
+    let lu = crate::lanes::after(b.partial_piv_lu());
     // P B = L U: the right-hand sides permuted (`y_i = r_{P(i)}`, row-major, 3m wide), then
     // the two substitutions over each factor row's nonzeros alone. The collocation matrix
     // is banded (p + 1 entries a row), and so nearly are its factors: n · band · 3m

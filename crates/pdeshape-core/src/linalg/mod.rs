@@ -47,7 +47,7 @@ pub fn condition_number(a: &Mat<f64>) -> Result<f64, LinalgError> {
     if !(0..a.nrows()).all(|i| (0..a.ncols()).all(|j| a[(i, j)].is_finite())) {
         return Err(LinalgError::NonFinite);
     }
-    let s = a.singular_values().map_err(|_| LinalgError::NoConvergence)?;
+    let s = crate::lanes::after(a.singular_values()).map_err(|_| LinalgError::NoConvergence)?;
     let max = s.iter().cloned().max_nan();
     let min = s.iter().cloned().fold(f64::INFINITY, f64::min);
     Ok(if min > 0.0 { max / min } else { f64::INFINITY })
@@ -67,7 +67,7 @@ impl SquareSolver {
         if cond.is_nan() || cond > max_cond {
             return Err(LinalgError::Singular { cond });
         }
-        Ok(SquareSolver { lu: a.full_piv_lu(), cond })
+        Ok(SquareSolver { lu: crate::lanes::after(a.full_piv_lu()), cond })
     }
 
     /// The 2-norm condition number of the factorized matrix.
@@ -77,7 +77,7 @@ impl SquareSolver {
 
     /// Solves `A X = B` for every column of `B`.
     pub fn solve(&self, b: &Mat<f64>) -> Mat<f64> {
-        self.lu.solve(b)
+        crate::lanes::after(self.lu.solve(b))
     }
 }
 
@@ -104,7 +104,8 @@ impl SpdSolver {
             return Err(LinalgError::NonFinite);
         }
         // nondecreasing
-        let ev = a.self_adjoint_eigenvalues(Side::Lower).map_err(|_| LinalgError::NoConvergence)?;
+        let ev =
+            crate::lanes::after(a.self_adjoint_eigenvalues(Side::Lower)).map_err(|_| LinalgError::NoConvergence)?;
         let cond = match (ev.first(), ev.last()) {
             (Some(&min), Some(&max)) if min > 0.0 => max / min,
             (Some(_), Some(_)) => f64::INFINITY,
@@ -113,7 +114,7 @@ impl SpdSolver {
         if cond.is_nan() || cond > max_cond {
             return Err(LinalgError::Singular { cond });
         }
-        let llt = a.llt(Side::Lower).map_err(|_| LinalgError::Singular { cond: f64::INFINITY })?;
+        let llt = crate::lanes::after(a.llt(Side::Lower)).map_err(|_| LinalgError::Singular { cond: f64::INFINITY })?;
         Ok(SpdSolver { llt, cond })
     }
 
@@ -124,7 +125,7 @@ impl SpdSolver {
 
     /// Solves `A X = B` for every column of `B`.
     pub fn solve(&self, b: &Mat<f64>) -> Mat<f64> {
-        self.llt.solve(b)
+        crate::lanes::after(self.llt.solve(b))
     }
 }
 
@@ -141,17 +142,17 @@ pub fn least_squares(a: &Mat<f64>, b: &Mat<f64>, max_cond: f64) -> Result<(Mat<f
         if cond.is_nan() || cond > max_cond {
             return Err(LinalgError::Singular { cond });
         }
-        return Ok((a.col_piv_qr().solve_lstsq(b), cond));
+        return Ok((crate::lanes::after(a.col_piv_qr().solve_lstsq(b)), cond));
     }
     if !(0..a.ncols()).all(|j| (0..a.nrows()).all(|i| a[(i, j)].is_finite())) {
         return Err(LinalgError::NonFinite);
     }
-    let qr = a.col_piv_qr();
+    let qr = crate::lanes::after(a.col_piv_qr());
     let cond = condition_number(&qr.thin_R().to_owned())?;
     if cond.is_nan() || cond > max_cond {
         return Err(LinalgError::Singular { cond });
     }
-    Ok((qr.solve_lstsq(b), cond))
+    Ok((crate::lanes::after(qr.solve_lstsq(b)), cond))
 }
 
 /// Minimum-norm least squares `min ‖A x − B‖` by the thin SVD, dropping singular values
@@ -162,10 +163,10 @@ pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<
     if !(0..a.nrows()).all(|i| (0..a.ncols()).all(|j| a[(i, j)].is_finite())) {
         return Err(LinalgError::NonFinite);
     }
-    let svd = a.thin_svd().map_err(|_| LinalgError::NoConvergence)?;
+    let svd = crate::lanes::after(a.thin_svd()).map_err(|_| LinalgError::NoConvergence)?;
     let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
     let smax = (0..s.nrows()).map(|i| s[i]).max_nan();
-    let mut utb = u.transpose() * b;
+    let mut utb = crate::lanes::after(u.transpose() * b);
     let mut rank = 0;
     for i in 0..s.nrows() {
         let keep = s[i] > rcond * smax && s[i] > 0.0;
@@ -174,7 +175,7 @@ pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<
             utb[(i, c)] = if keep { utb[(i, c)] / s[i] } else { 0.0 };
         }
     }
-    Ok((v * utb, rank))
+    Ok((crate::lanes::after(v * utb), rank))
 }
 
 /// An estimate of `‖A⁻¹‖₁` from a factorization of `A` (`n × n`), by Hager's method with
@@ -183,7 +184,7 @@ pub fn least_squares_min_norm(a: &Mat<f64>, b: &Mat<f64>, rcond: f64) -> Result<
 /// many matrices and rarely below a third of the true value (Higham, "Accuracy and
 /// Stability of Numerical Algorithms", §15.3). NaN in, NaN out.
 pub fn inverse_norm1_estimate(lu: &impl Solve<f64>, n: usize) -> f64 {
-    inverse_norm1_estimate_by(n, |b| lu.solve(b), |b| lu.solve_transpose(b))
+    inverse_norm1_estimate_by(n, |b| crate::lanes::after(lu.solve(b)), |b| crate::lanes::after(lu.solve_transpose(b)))
 }
 
 /// [`inverse_norm1_estimate`] with the solves with `A` and `Aᵀ` given (a factorization

@@ -177,8 +177,8 @@ impl UltraCardinal {
                 a[(n + j, m)] = r[j][m] / mx;
             }
         }
-        let lu = a.partial_piv_lu();
-        let x = lu.solve(&b);
+        let lu = crate::lanes::after(a.partial_piv_lu());
+        let x = crate::lanes::after(lu.solve(&b));
         // condition number ‖A‖₁ ‖A⁻¹‖₁, the second factor estimated (a few solves instead of
         // the inverse's K: most of this function's time went there)
         let norm1 = |m: &Mat<f64>| {

@@ -243,8 +243,8 @@ impl SolidBlend {
                 let x = if galerkin {
                     // Σ_k w_k ψ_n'(w_k) [(λψ + γψ⁗) a + r](w_k) = 0
                     let t = Mat::from_fn(qw, nn, |k, n| ww[k].sqrt() * p0[k][n]);
-                    let a = t.transpose() * &g;
-                    let b = t.transpose() * &rhs;
+                    let a = crate::lanes::after(t.transpose() * &g);
+                    let b = crate::lanes::after(t.transpose() * &rhs);
                     let solver =
                         crate::linalg::SquareSolver::new(&a, 1e14).map_err(|e| SolidError::Solve(e.to_string()))?;
                     cond = crate::num::max_nan(cond, solver.cond());

@@ -800,6 +800,7 @@ impl SpectralPatch {
                     1.0,
                     faer::Par::Seq,
                 );
+                crate::lanes::clear_upper();
                 pt
             })
             .collect();

@@ -391,3 +391,29 @@ fn ninth_derivative_conditions_hold() {
     // each condition is then its datum's Fourier sum and tail added back: a few ulps (0 seen)
     assert!(rep.max_rel <= 1e-14, "error {:e}", rep.max_rel);
 }
+
+/// The grid's products go through faer's GEMM, whose kernels on a CPU with AVX leave the
+/// vector registers' upper lanes in use; the grid clears them on the thread that ran the
+/// product. Left in use, every scalar instruction after it (the normals, the fold check,
+/// the CAD fit on that worker) carries a false dependency on them: a 200 × 200 mesh's
+/// normal pass ran 4× slower ([`crate::lanes`]).
+#[test]
+fn grid_products_leave_the_upper_lanes_clear() {
+    let a = 0.9;
+    let conds: Vec<Condition> = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
+        .iter()
+        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
+        .collect();
+    let p = SpectralPatch::new(&conds, VDomain::PERIODIC, SpectralOptions { a, modes: 3, omega: None }).unwrap();
+    let us: Vec<f64> = (0..60).map(|i| i as f64 / 59.0).collect();
+    let vs: Vec<f64> = (0..60).map(|j| VDomain::PERIODIC.at(j as f64 / 59.0)).collect();
+    // one worker: the products and this check run on the same thread
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let (g, state) = pool.install(|| {
+        let g = p.grid(&us, &vs);
+        (g, crate::lanes::upper_in_use())
+    });
+    let d = p.derivatives(us[17], vs[40], 1, 1);
+    assert!((g[17 * 60 + 40][0] - d[0]).norm() < 1e-12);
+    assert_ne!(state, Some(true), "the upper lanes were left in use");
+}

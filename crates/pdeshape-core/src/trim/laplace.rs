@@ -191,6 +191,7 @@ impl LaplaceMap {
         let gm = faer::Mat::<f64>::from_fn(kk, 2 * columns, |k, c| g[k * 2 * columns + c]);
         let mut out = faer::Mat::<f64>::zeros(rings, 2 * columns);
         faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, e.as_ref(), gm.as_ref(), 1.0, faer::Par::Seq);
+        crate::lanes::clear_upper();
         let mut p: Vec<Uv> = (0..rings)
             .flat_map(|i| (0..columns).map(move |j| (i, j)))
             .map(|(i, j)| [out[(i, 2 * j)], out[(i, 2 * j + 1)]])

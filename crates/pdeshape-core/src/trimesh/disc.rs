@@ -129,7 +129,7 @@ impl DiscSurface {
             }
         }
         use faer::linalg::solvers::Solve;
-        let sol = g.full_piv_lu().solve(&rhs);
+        let sol = crate::lanes::after(g.full_piv_lu().solve(&rhs));
         let [ca, cb, cc, cd, ce] = std::array::from_fn(|i| sol[(i, 0)]);
         // centre: the gradient of the quadratic vanishes
         let det = 4.0 * ca * cc - cb * cb;

@@ -593,7 +593,7 @@ fn boundary_line(fit: &CollarFit, h: f64, band: &[BandVertex]) -> DomainLine {
     for i in 0..nc {
         g[(i, i)] += 1e-9;
     }
-    let sol = g.full_piv_lu().solve(&r);
+    let sol = crate::lanes::after(g.full_piv_lu().solve(&r));
     let mut ctrl: Vec<f64> = (0..nc).map(|i| sol[(i, 0)]).collect();
     let line = DomainLine::new(b, &ctrl);
     let over = fit.params.iter().fold(f64::NEG_INFINITY, |a, &(s, w)| max_nan(a, line.sigma(w) - (s - 0.4 * h)));

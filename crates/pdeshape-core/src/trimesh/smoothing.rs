@@ -244,8 +244,8 @@ mod tests {
                 y[(i, c)] = v + 0.05 * normal();
             }
         }
-        let g = a.transpose() * &a;
-        let r = a.transpose() * &y;
+        let g = crate::lanes::after(a.transpose() * &a);
+        let r = crate::lanes::after(a.transpose() * &y);
         let yy: f64 = (0..n).flat_map(|i| (0..3).map(move |c| (i, c))).map(|(i, c)| y[(i, c)].powi(2)).sum();
         // the base: 10⁻⁶ of the mean diagonal on second differences
         let lam = 1e-6 * (0..len).map(|i| g[(i, i)]).sum::<f64>() / len as f64;
@@ -266,12 +266,12 @@ mod tests {
         let dense = |w: f64| {
             let m = &g + &om * faer::Scale(w * unit) + &base;
             let llt = faer::linalg::solvers::Llt::new(m.as_ref(), faer::Side::Lower).unwrap();
-            let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
-            let h = &a * &inv * a.transpose();
+            let inv = crate::lanes::after(faer::linalg::solvers::DenseSolveCore::inverse(&llt));
+            let h = crate::lanes::after(&a * &inv * a.transpose());
             let trh: f64 = (0..n).map(|i| h[(i, i)]).sum();
-            let e = &y - &h * &y;
+            let e = crate::lanes::after(&y - &h * &y);
             let rss: f64 = (0..n).flat_map(|i| (0..3).map(move |c| (i, c))).map(|(i, c)| e[(i, c)].powi(2)).sum();
-            (rss * n as f64 / (n as f64 - trh).powi(2), trh, &inv * &r)
+            (rss * n as f64 / (n as f64 - trh).powi(2), trh, crate::lanes::after(&inv * &r))
         };
         let (v, trh, x) = dense(fit.weight);
         // tr H is a sum of 60 terms ~1, each to round-off times the system's condition
