@@ -277,37 +277,55 @@ pub fn patch_meshes(scene: &Scene) -> Result<Vec<Mesh>, String> {
     scene.patches.iter().map(patch_mesh).collect()
 }
 
-/// FNV-1a (64-bit) over every buffer of every mesh, in order: names, the `f64` bits of
+/// A 64-bit fingerprint of every buffer of every mesh, in order: names, the `f64` bits of
 /// positions, normals, UVs, fields, curves and animation frames, the face indices and the
 /// grid shape, each buffer preceded by its length (so moving a value from one buffer to the
 /// next changes the hash). The fingerprint of a model the editor shows to its page and the
 /// tests compare with the library's meshes (thread independence, the load test): equal
-/// hashes mean bit-identical meshes, not equal `f32` renderings.
+/// hashes mean bit-identical meshes (up to a collision), not equal `f32` renderings.
+///
+/// One step per 64-bit word `w`: `h ← m((h ⊕ w) · P)` with FNV's odd prime `P` and
+/// `m(x) = x ⊕ (x ≫ 32)`. Each of the three maps is a bijection of `h` for a fixed `w` and of
+/// `w` for a fixed `h`, so meshes that differ in one word always hash differently. (The
+/// editor answers every request with this hash; FNV-1a a byte at a time was 18 % of the
+/// server's time under the load test.)
 pub fn mesh_hash(meshes: &[Mesh]) -> String {
     struct Fnv(u64);
     impl Fnv {
+        fn word(&mut self, w: u64) {
+            let x = (self.0 ^ w).wrapping_mul(0x100000001b3);
+            self.0 = x ^ (x >> 32);
+        }
+        /// Bytes in little-endian words, the last one padded with zeros (the length that
+        /// precedes every byte buffer tells the padding apart).
         fn bytes(&mut self, b: &[u8]) {
-            for &x in b {
-                self.0 ^= x as u64;
-                self.0 = self.0.wrapping_mul(0x100000001b3);
+            for c in b.chunks(8) {
+                let mut w = [0u8; 8];
+                w[..c.len()].copy_from_slice(c);
+                self.word(u64::from_le_bytes(w));
             }
         }
         fn len(&mut self, n: usize) {
-            self.bytes(&(n as u64).to_le_bytes());
+            self.word(n as u64);
         }
         fn f64s(&mut self, xs: impl ExactSizeIterator<Item = f64>) {
             self.len(xs.len());
             for x in xs {
-                self.bytes(&x.to_bits().to_le_bytes());
+                self.word(x.to_bits());
             }
         }
         fn vec3s(&mut self, v: &[pdeshape_core::Vec3]) {
-            self.f64s(v.iter().flat_map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>().into_iter());
+            self.len(3 * v.len());
+            for p in v {
+                self.word(p.x.to_bits());
+                self.word(p.y.to_bits());
+                self.word(p.z.to_bits());
+            }
         }
         fn u32s(&mut self, xs: &[u32]) {
             self.len(xs.len());
             for x in xs {
-                self.bytes(&x.to_le_bytes());
+                self.word(u64::from(*x));
             }
         }
     }
@@ -318,11 +336,12 @@ pub fn mesh_hash(meshes: &[Mesh]) -> String {
         h.bytes(m.name.as_bytes());
         h.vec3s(&m.positions);
         h.vec3s(&m.normals);
-        h.f64s(m.uvs.iter().flatten().copied().collect::<Vec<_>>().into_iter());
+        h.f64s(m.uvs.as_flattened().iter().copied());
         h.u32s(m.quads.as_flattened());
         h.u32s(m.triangles.as_flattened());
         h.len(m.fields.len());
         for f in &m.fields {
+            h.len(f.name.len());
             h.bytes(f.name.as_bytes());
             h.f64s(f.values.iter().copied());
         }
@@ -878,6 +897,16 @@ mod tests {
         changes.push(m);
         let mut m = mesh();
         m.name = "n".into();
+        changes.push(m);
+        // two signs (the top bits of two words): with `h ← (h ⊕ w) · P` alone a top-bit
+        // difference stays in the top bit and the second cancels the first
+        let mut m = mesh();
+        m.positions[1].x = -1.0;
+        m.positions[2].y = -1.0;
+        changes.push(m);
+        // a zero byte appended to a name (the same padded word; the length tells them apart)
+        let mut m = mesh();
+        m.name = "m\0".into();
         changes.push(m);
         for (k, m) in changes.iter().enumerate() {
             assert_ne!(mesh_hash(std::slice::from_ref(m)), h, "change {k} not seen");
