@@ -42,14 +42,20 @@ fn data_of(f: impl Fn(&Jet, &Jet) -> [Jet; 3] + Send + Sync + 'static, u0: f64, 
     }))
 }
 
+/// The positions and slopes of [`exact`] at `u = 0` and `1`: the conditions of a
+/// fourth-order patch that is [`exact`] itself.
+fn end_conditions(a: f64) -> Vec<Condition> {
+    [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
+        .iter()
+        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
+        .collect()
+}
+
 #[test]
 fn finite_fourier_data_reproduce_the_closed_form() {
     let a = 1.1;
     let f = exact(a);
-    let conds: Vec<Condition> = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
-        .iter()
-        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
-        .collect();
+    let conds = end_conditions(a);
     let p = SpectralPatch::new(&conds, VDomain::PERIODIC, SpectralOptions { a, modes: 4, omega: None }).unwrap();
     let mut worst: f64 = 0.0;
     for i in 0..=20 {
@@ -206,10 +212,7 @@ fn open_patches_use_the_even_extension() {
 #[test]
 fn grid_evaluation_matches_pointwise_derivatives() {
     let a = 0.9;
-    let conds: Vec<Condition> = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
-        .iter()
-        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
-        .collect();
+    let conds = end_conditions(a);
     for dom in [VDomain::PERIODIC, VDomain::open(0.5, 2.0)] {
         let p = SpectralPatch::new(&conds, dom, SpectralOptions { a, modes: 3, omega: None }).unwrap();
         let us = [0.0, 0.3, 0.77, 1.0];
@@ -400,10 +403,7 @@ fn ninth_derivative_conditions_hold() {
 #[test]
 fn grid_products_leave_the_upper_lanes_clear() {
     let a = 0.9;
-    let conds: Vec<Condition> = [(0.0, 0), (0.0, 1), (1.0, 0), (1.0, 1)]
-        .iter()
-        .map(|&(u, d)| Condition { u, order: d, data: data_of(exact(a), u, d) })
-        .collect();
+    let conds = end_conditions(a);
     let p = SpectralPatch::new(&conds, VDomain::PERIODIC, SpectralOptions { a, modes: 3, omega: None }).unwrap();
     let us: Vec<f64> = (0..60).map(|i| i as f64 / 59.0).collect();
     let vs: Vec<f64> = (0..60).map(|j| VDomain::PERIODIC.at(j as f64 / 59.0)).collect();
