@@ -3,7 +3,7 @@
 
 mod grid;
 
-pub use grid::{GridOptions, grid_mesh, grid_params};
+pub use grid::{GridOptions, grid_mesh, grid_mesh_with_curvatures, grid_params};
 
 use crate::Vec3;
 

@@ -4,7 +4,7 @@ use crate::render::{CONTEXT_COLOR, Camera, Image, PALETTE, RenderItem, render};
 use crate::scene::{RenderSettings, Scene, ScenePatch};
 use pdeshape_core::blend::{DynamicFrame, Gaps, Solver, StaticBlend, attached_gaps_at, gaps_at};
 use pdeshape_core::data::FieldRef;
-use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh};
+use pdeshape_core::mesh::{GridOptions, Mesh, ScalarField, grid_mesh, grid_mesh_with_curvatures};
 use pdeshape_core::num::MaxNan;
 use pdeshape_core::patch::PrimarySurface;
 use pdeshape_core::patch::{CurvatureKind, Surface};
@@ -27,25 +27,31 @@ pub const CONDITION_WARNING: f64 = 1e-8;
 /// Meshes one patch at its resolution, with its position conditions as highlighted
 /// curves. Fails when the patch is not finite somewhere.
 pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
-    let m = unchecked_mesh(p)?;
+    let (m, _) = unchecked_mesh(p, &[])?;
     m.check_finite()?;
     Ok(m)
 }
 
 /// [`patch_mesh`] before its finiteness check.
-fn unchecked_mesh(p: &ScenePatch) -> Result<Mesh, String> {
+/// The patch's mesh; on an untrimmed grid with the curvature fields `kinds` too, from the
+/// same evaluation (`grid_mesh_with_curvatures`), last among its fields (the returned
+/// flag: they are there).
+fn unchecked_mesh(p: &ScenePatch, kinds: &[CurvatureKind]) -> Result<(Mesh, bool), String> {
     if let Some(sd) = &p.solid {
         let mut m = pdeshape_core::solid::boundary_mesh(&sd.blend, sd.cells);
         m.name = p.name.clone();
-        return Ok(m);
+        return Ok((m, false));
     }
     let (nu, nv) = p.resolution;
+    let with_curvatures = p.trim.is_none() && !kinds.is_empty();
     let mut m = match &p.trim {
         // a trimmed patch: the (ρ, φ) grid of its region; the trim loop is its highlighted curve
         Some(t) => pdeshape_core::trim::trimmed_mesh(p.surface.as_ref(), &t.grid),
+        None if with_curvatures => grid_mesh_with_curvatures(p.surface.as_ref(), &GridOptions::new(nu, nv), kinds),
         None => grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)),
     }
     .map_err(|e| format!("patch `{}`: {e}", p.name))?;
+    let curvatures = std::mem::take(&mut m.fields);
     m.name = p.name.clone();
     let dom = p.surface.v_domain();
     let n = (4 * nv).max(64);
@@ -68,7 +74,8 @@ fn unchecked_mesh(p: &ScenePatch) -> Result<Mesh, String> {
     if let Some(d) = &p.dynamic {
         m.animation = Some(dynamic_animation(p, d)?);
     }
-    Ok(m)
+    m.fields.extend(curvatures);
+    Ok((m, with_curvatures))
 }
 
 /// The frames of a dynamic blend as morph targets: positions and normals of the same grid
@@ -97,15 +104,17 @@ pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
 /// `t` for a dynamic blend; none for solids, whose boundary is not one surface).
 pub fn analysis_mesh(p: &ScenePatch, t: Option<f64>, kinds: &[CurvatureKind]) -> Result<Mesh, String> {
     let m = match (&p.dynamic, t) {
-        _ if p.solid.is_some() => unchecked_mesh(p)?,
+        _ if p.solid.is_some() => unchecked_mesh(p, &[])?.0,
         (Some(d), Some(t)) => {
             let (mut m, frame) = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
             m.add_curvatures(&frame, kinds);
             m
         }
         _ => {
-            let mut m = unchecked_mesh(p)?;
-            m.add_curvatures(p.surface.as_ref(), kinds);
+            let (mut m, done) = unchecked_mesh(p, kinds)?;
+            if !done {
+                m.add_curvatures(p.surface.as_ref(), kinds);
+            }
             m
         }
     };
