@@ -171,7 +171,14 @@ struct Trim {
 struct Buffers(Vec<u8>);
 
 impl Buffers {
-    fn f32s(&mut self, xs: impl Iterator<Item = f32>) -> Slice {
+    /// Room for `n` more 4-byte values: the answer's buffers grow once per buffer, not
+    /// by doubling through a megabyte.
+    fn reserve(&mut self, n: usize) {
+        self.0.reserve(4 * n);
+    }
+
+    fn f32s(&mut self, xs: impl ExactSizeIterator<Item = f32>) -> Slice {
+        self.reserve(xs.len());
         let offset = self.0.len();
         let mut count = 0;
         for x in xs {
@@ -182,6 +189,7 @@ impl Buffers {
     }
 
     fn u32s(&mut self, xs: impl Iterator<Item = u32>) -> Slice {
+        self.reserve(xs.size_hint().0);
         let offset = self.0.len();
         let mut count = 0;
         for x in xs {
@@ -191,8 +199,15 @@ impl Buffers {
         Slice { offset, count }
     }
 
-    fn points<'p>(&mut self, ps: impl Iterator<Item = &'p pdeshape_core::Vec3>) -> Slice {
-        self.f32s(ps.flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]))
+    fn points(&mut self, ps: &[pdeshape_core::Vec3]) -> Slice {
+        self.reserve(3 * ps.len());
+        let offset = self.0.len();
+        for p in ps {
+            for x in [p.x, p.y, p.z] {
+                self.0.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+        }
+        Slice { offset, count: 3 * ps.len() }
     }
 }
 
@@ -219,14 +234,15 @@ pub fn encode(s: &Model, diagnostics: bool, curves: Option<Vec<PatchCurves>>) ->
     let mut buf = Buffers(Vec::new());
     let mut patches = Vec::new();
     for (m, p) in s.meshes.iter().zip(&s.scene.patches) {
-        let positions = buf.points(m.positions.iter());
-        let normals = buf.points(m.normals.iter());
-        let indices = buf.u32s(m.all_triangles().into_iter().flatten());
+        let positions = buf.points(&m.positions);
+        let normals = buf.points(&m.normals);
+        let indices = buf.u32s(m.all_triangles().as_flattened().iter().copied());
         // wireframe: quad edges (and triangle edges)
         let quad_edges = m.quads.iter().flat_map(|q| (0..4).flat_map(move |k| [q[k], q[(k + 1) % 4]]));
         let tri_edges = m.triangles.iter().flat_map(|t| (0..3).flat_map(move |k| [t[k], t[(k + 1) % 3]]));
+        buf.reserve(8 * m.quads.len() + 6 * m.triangles.len());
         let lines = buf.u32s(quad_edges.chain(tri_edges));
-        let curves = m.curves.iter().map(|c| buf.points(c.iter())).collect();
+        let curves = m.curves.iter().map(|c| buf.points(c)).collect();
         let fields = m
             .fields
             .iter()
@@ -257,14 +273,14 @@ pub fn encode(s: &Model, diagnostics: bool, curves: Option<Vec<PatchCurves>>) ->
         .map(|m| ContextMesh {
             name: &m.name,
             vertices: m.positions.len(),
-            positions: buf.points(m.positions.iter()),
-            normals: buf.points(m.normals.iter()),
-            indices: buf.u32s(m.all_triangles().into_iter().flatten()),
+            positions: buf.points(&m.positions),
+            normals: buf.points(&m.normals),
+            indices: buf.u32s(m.all_triangles().as_flattened().iter().copied()),
         })
         .collect();
     let holes = model::import_hole_loops(s.scene)
         .into_iter()
-        .map(|(name, points)| HoleLoop { name, points: buf.points(points.iter()) })
+        .map(|(name, points)| HoleLoop { name, points: buf.points(&points) })
         .collect();
     let header = Header {
         name: &s.scene.name,
