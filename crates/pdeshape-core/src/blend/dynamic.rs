@@ -108,8 +108,8 @@ impl DynBasis {
         out
     }
 
-    fn derivs(&self, v: f64, t: f64) -> FDerivs {
-        fderivs(&self.partials(v, t, 4, 2))
+    fn eigen_derivs(&self, v: f64, t: f64) -> EigenDerivs {
+        eigen_derivs(&self.partials(v, t, 2, 2))
     }
 
     /// A short name.
@@ -124,7 +124,7 @@ impl DynBasis {
     /// eigenfunction: tested at 9 × 5 points of the domain and time range from exact
     /// derivatives (relative tolerance 1e-11).
     pub fn eigenvalues(&self, domain: VDomain, times: (f64, f64)) -> Option<(f64, f64)> {
-        eigen_from(eigen_points(domain, times).map(|(v, t)| self.derivs(v, t)))
+        eigen_from(eigen_points(domain, times).map(|(v, t)| self.eigen_derivs(v, t)))
     }
 }
 
@@ -166,11 +166,28 @@ fn fderivs(p: &[f64]) -> FDerivs {
     FDerivs { f: p[0], fvv: p[6], fvvvv: p[12], ft: p[1], ftt: p[2] }
 }
 
+/// `F, ∂v²F, ∂tF, ∂t²F` at a point: what the eigenfunction test reads.
+#[derive(Clone, Copy, Debug)]
+struct EigenDerivs {
+    f: f64,
+    fvv: f64,
+    ft: f64,
+    ftt: f64,
+}
+
+/// [`EigenDerivs`] from the partials of orders (2, 2) (index `i·3 + j`). Jets of that
+/// order carry the same coefficients up to it as those of order (4, 2), from the same
+/// sums (a truncated product's low coefficients do not read the high ones), at half the
+/// coefficients — a third of eq. 19's closed-form solve went to this test at (4, 2).
+fn eigen_derivs(p: &[f64]) -> EigenDerivs {
+    EigenDerivs { f: p[0], fvv: p[6], ft: p[1], ftt: p[2] }
+}
+
 /// `(μ, κ)` of every basis function that is an eigenfunction (see
 /// [`DynBasis::eigenvalues`]), sharing field evaluations.
 fn eigen_all(basis: &[DynBasis], domain: VDomain, times: (f64, f64)) -> Vec<Option<(f64, f64)>> {
-    let pts: Vec<Vec<FDerivs>> = eigen_points(domain, times)
-        .map(|(v, t)| partials_all(basis, v, t, 4, 2).iter().map(|p| fderivs(p)).collect())
+    let pts: Vec<Vec<EigenDerivs>> = eigen_points(domain, times)
+        .map(|(v, t)| partials_all(basis, v, t, 2, 2).iter().map(|p| eigen_derivs(p)).collect())
         .collect();
     (0..basis.len()).map(|j| eigen_from(pts.iter().map(|row| row[j]))).collect()
 }
@@ -182,8 +199,8 @@ fn eigen_points(domain: VDomain, times: (f64, f64)) -> impl Iterator<Item = (f64
     })
 }
 
-fn eigen_from(pts: impl Iterator<Item = FDerivs>) -> Option<(f64, f64)> {
-    let pts: Vec<FDerivs> = pts.collect();
+fn eigen_from(pts: impl Iterator<Item = EigenDerivs>) -> Option<(f64, f64)> {
+    let pts: Vec<EigenDerivs> = pts.collect();
     let den: f64 = pts.iter().map(|d| d.f * d.f).sum();
     if den == 0.0 || !den.is_finite() {
         return None;
@@ -804,6 +821,33 @@ mod tests {
             let paper_slope = |u: f64| sg * w * (2.0 * u - 3.0 * u * u) + w * (w * u).cos();
             assert!((paper_slope(0.0) - w).abs() < 1e-12 * w);
             assert!(zeta(k, 0.0)[1].abs() < 1e-12 * w, "k {k}: the corrected slope at 0");
+        }
+    }
+
+    /// The eigenfunction test reads `F, F_vv, F_t, F_tt` from jets of order (2, 2); those of
+    /// order (4, 2) (the collocation's) give the same numbers bit for bit, for expression
+    /// terms and for whole data components.
+    #[test]
+    fn eigen_test_jets_of_order_two_match_those_of_order_four() {
+        let mut conds = eq19();
+        // a field that is no expression: its components are data basis functions
+        let data = crate::data::FnField::new(2, |p: &[Jet]| {
+            let (v, t) = (&p[0], &p[1]);
+            let y = t.neg().exp().mul(&v.cos()).mul(&v.cos().add_scalar(2.0).sqrt());
+            [t.exp().mul(&v.sin()).scale(1.6), y, Jet::constant(v.shape(), 2.0)]
+        });
+        conds[2] = Condition { u: 1.0, order: 0, data: Arc::new(data) };
+        let (basis, _) = extract(&conds.iter().collect::<Vec<_>>());
+        assert!(basis.iter().any(|b| matches!(b, DynBasis::Data { .. })), "a data component is tested");
+        assert!(basis.iter().any(|b| matches!(b, DynBasis::Expr { .. })), "an expression term is tested");
+        for (v, t) in eigen_points(VDomain::PERIODIC, (-0.4, 0.9)) {
+            let low = partials_all(&basis, v, t, 2, 2);
+            let high = partials_all(&basis, v, t, 4, 2);
+            for (l, h) in low.iter().zip(&high) {
+                let (a, b) = (eigen_derivs(l), fderivs(h));
+                let bits = |x: [f64; 4]| x.map(f64::to_bits);
+                assert_eq!(bits([a.f, a.fvv, a.ft, a.ftt]), bits([b.f, b.fvv, b.ft, b.ftt]), "at ({v}, {t})");
+            }
         }
     }
 
