@@ -110,23 +110,29 @@ pub(super) struct Entities {
 
 impl Entities {
     pub(super) fn add(&mut self, body: &str) -> usize {
+        self.add_with(|text| text.push_str(body))
+    }
+
+    /// [`add`](Self::add) with the body written into the text in place by `body`.
+    fn add_with(&mut self, body: impl FnOnce(&mut String)) -> usize {
         self.next += 1;
-        let _ = writeln!(self.text, "#{}={body};", self.next);
+        let _ = write!(self.text, "#{}=", self.next);
+        body(&mut self.text);
+        self.text.push_str(";\n");
         self.next
     }
 
     pub(super) fn point(&mut self, p: Vec3) -> usize {
-        // `add`'s line written in place
-        self.next += 1;
-        let _ = write!(self.text, "#{}=CARTESIAN_POINT('',(", self.next);
-        for (k, x) in [p.x, p.y, p.z].into_iter().enumerate() {
-            if k > 0 {
-                self.text.push(',');
+        self.add_with(|text| {
+            text.push_str("CARTESIAN_POINT('',(");
+            for (k, x) in [p.x, p.y, p.z].into_iter().enumerate() {
+                if k > 0 {
+                    text.push(',');
+                }
+                push_real(text, x);
             }
-            push_real(&mut self.text, x);
-        }
-        self.text.push_str("));\n");
-        self.next
+            text.push_str("))");
+        })
     }
 
     pub(super) fn list(ids: impl IntoIterator<Item = usize>) -> String {

@@ -27,27 +27,25 @@ pub const CONDITION_WARNING: f64 = 1e-8;
 /// Meshes one patch at its resolution, with its position conditions as highlighted
 /// curves. Fails when the patch is not finite somewhere.
 pub fn patch_mesh(p: &ScenePatch) -> Result<Mesh, String> {
-    let (m, _) = unchecked_mesh(p, &[])?;
+    let m = unchecked_mesh(p, &[])?;
     m.check_finite()?;
     Ok(m)
 }
 
-/// [`patch_mesh`] before its finiteness check.
-/// The patch's mesh; on an untrimmed grid with the curvature fields `kinds` too, from the
-/// same evaluation (`grid_mesh_with_curvatures`), last among its fields (the returned
-/// flag: they are there).
-fn unchecked_mesh(p: &ScenePatch, kinds: &[CurvatureKind]) -> Result<(Mesh, bool), String> {
+/// [`patch_mesh`] before its finiteness check, with the curvature fields `kinds` last
+/// among its fields (on an untrimmed grid from the mesh's own evaluation,
+/// `grid_mesh_with_curvatures`; none for solids, whose boundary is not one surface).
+fn unchecked_mesh(p: &ScenePatch, kinds: &[CurvatureKind]) -> Result<Mesh, String> {
     if let Some(sd) = &p.solid {
         let mut m = pdeshape_core::solid::boundary_mesh(&sd.blend, sd.cells);
         m.name = p.name.clone();
-        return Ok((m, false));
+        return Ok(m);
     }
     let (nu, nv) = p.resolution;
-    let with_curvatures = p.trim.is_none() && !kinds.is_empty();
     let mut m = match &p.trim {
         // a trimmed patch: the (ρ, φ) grid of its region; the trim loop is its highlighted curve
         Some(t) => pdeshape_core::trim::trimmed_mesh(p.surface.as_ref(), &t.grid),
-        None if with_curvatures => grid_mesh_with_curvatures(p.surface.as_ref(), &GridOptions::new(nu, nv), kinds),
+        None if !kinds.is_empty() => grid_mesh_with_curvatures(p.surface.as_ref(), &GridOptions::new(nu, nv), kinds),
         None => grid_mesh(p.surface.as_ref(), &GridOptions::new(nu, nv)),
     }
     .map_err(|e| format!("patch `{}`: {e}", p.name))?;
@@ -75,7 +73,10 @@ fn unchecked_mesh(p: &ScenePatch, kinds: &[CurvatureKind]) -> Result<(Mesh, bool
         m.animation = Some(dynamic_animation(p, d)?);
     }
     m.fields.extend(curvatures);
-    Ok((m, with_curvatures))
+    if p.trim.is_some() {
+        m.add_curvatures(p.surface.as_ref(), kinds);
+    }
+    Ok(m)
 }
 
 /// The frames of a dynamic blend as morph targets: positions and normals of the same grid
@@ -104,19 +105,13 @@ pub fn editor_mesh(p: &ScenePatch, t: Option<f64>) -> Result<Mesh, String> {
 /// `t` for a dynamic blend; none for solids, whose boundary is not one surface).
 pub fn analysis_mesh(p: &ScenePatch, t: Option<f64>, kinds: &[CurvatureKind]) -> Result<Mesh, String> {
     let m = match (&p.dynamic, t) {
-        _ if p.solid.is_some() => unchecked_mesh(p, &[])?.0,
+        _ if p.solid.is_some() => unchecked_mesh(p, &[])?,
         (Some(d), Some(t)) => {
             let (mut m, frame) = frame_mesh(p, d, t.clamp(d.times.0, d.times.1))?;
             m.add_curvatures(&frame, kinds);
             m
         }
-        _ => {
-            let (mut m, done) = unchecked_mesh(p, kinds)?;
-            if !done {
-                m.add_curvatures(p.surface.as_ref(), kinds);
-            }
-            m
-        }
+        _ => unchecked_mesh(p, kinds)?,
     };
     m.check_finite()?;
     Ok(m)

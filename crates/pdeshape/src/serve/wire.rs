@@ -178,22 +178,20 @@ impl Buffers {
     }
 
     fn f32s(&mut self, xs: impl ExactSizeIterator<Item = f32>) -> Slice {
-        self.reserve(xs.len());
-        let offset = self.0.len();
-        let mut count = 0;
-        for x in xs {
-            self.0.extend_from_slice(&x.to_le_bytes());
-            count += 1;
-        }
-        Slice { offset, count }
+        self.words(xs.map(f32::to_le_bytes))
     }
 
     fn u32s(&mut self, xs: impl Iterator<Item = u32>) -> Slice {
+        self.words(xs.map(u32::to_le_bytes))
+    }
+
+    /// 4-byte values in order, room for those the iterator promises reserved first.
+    fn words(&mut self, xs: impl Iterator<Item = [u8; 4]>) -> Slice {
         self.reserve(xs.size_hint().0);
         let offset = self.0.len();
         let mut count = 0;
         for x in xs {
-            self.0.extend_from_slice(&x.to_le_bytes());
+            self.0.extend_from_slice(&x);
             count += 1;
         }
         Slice { offset, count }
